@@ -1,0 +1,61 @@
+// Ray queries. Every intersection in the renderer goes through this interface; accel.cpp is the
+// one file that includes Embree.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "math.h"
+#include "scene.h"
+
+namespace pt {
+
+// A rectangle or triangle that emits and is visible to rays (area-light panels).
+struct EmitterPanel {
+  Vec3 v[4];       // corners; triangle panels repeat v[2] in v[3]
+  bool quad = true;
+  int material = -1;  // index into the materials list (emission)
+  int light = -1;     // index into the render scene's lights
+};
+
+struct SurfaceHit {
+  float t = kInf;
+  Vec3 p;            // hit point, refined from barycentrics or the sphere equation
+  Vec3 ng;           // unit geometric normal: triangle winding side / sphere outside
+  Vec3 ns;           // unit shading normal on the same side as ng
+  int material = -1;
+  int light = -1;    // >= 0 when the surface is an emitter registered as a light
+  float offset = 0;  // how far to push spawned rays off the surface (scale-aware)
+};
+
+class Accel {
+ public:
+  // Builds the acceleration structure once. `mesh_light` gives, per mesh and triangle, the light
+  // index of emissive triangles (or -1); it may be empty.
+  Accel(const SceneDesc& scene, const std::vector<EmitterPanel>& panels,
+        const std::vector<std::vector<int>>& mesh_light);
+  ~Accel();
+  Accel(const Accel&) = delete;
+  Accel& operator=(const Accel&) = delete;
+
+  bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  // True when anything blocks the ray within [ray.tmin, ray.tmax].
+  bool occluded(const Ray& ray) const;
+  // Bytes held by geometry buffers and the BVH (approximate, for --describe).
+  size_t memory_bytes() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> m_impl;
+};
+
+// A ray leaving the surface in direction d, origin pushed off to the side d points to.
+// Offsets follow Waechter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
+// Ray Tracing Gems ch. 6 (2019), so they scale with the hit's coordinates.
+Ray spawn_ray(const SurfaceHit& hit, Vec3 d);
+// A shadow ray from the surface to a point on another surface (target excluded).
+Ray spawn_ray_to(const SurfaceHit& hit, Vec3 target);
+Vec3 offset_ray_origin(Vec3 p, Vec3 n);
+
+}  // namespace pt

@@ -1,0 +1,167 @@
+// Camera placement (course framing, authored, or a settings file) and ray generation.
+#include "camera.h"
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "sampling.h"
+
+namespace pt {
+
+namespace {
+
+constexpr float kDeg = kPi / 180;
+
+void set_basis(Camera& c, Vec3 back, Vec3 up_hint) {
+  c.back = normalize(back);
+  Vec3 right = cross(up_hint, c.back);
+  if (length(right) < 1e-6f) right = cross(Vec3(0, 0, 1), c.back);  // looking straight up or down
+  c.right = normalize(right);
+  c.up = cross(c.back, c.right);
+}
+
+// The authored field of view, horizontal and vertical, in radians.
+void file_fov(const SceneDesc& scene, float* h_fov, float* v_fov) {
+  const CameraDesc& cd = scene.camera;
+  float xf = cd.xfov_deg * kDeg, yf = cd.yfov_deg * kDeg;
+  if (!cd.present) {
+    xf = 50 * kDeg;
+    yf = 0;
+  }
+  float aspect = cd.aspect > 0 ? cd.aspect : 4.0f / 3.0f;
+  if (yf <= 0) yf = 2 * std::atan(std::tan(xf / 2) / aspect);
+  if (xf <= 0) xf = 2 * std::atan(std::tan(yf / 2) * aspect);
+  *h_fov = xf;
+  *v_fov = yf;
+}
+
+void read_settings_file(Camera& c, const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open camera settings file");
+  float v[32];
+  const char* fields[] = {"hFov", "vFov", "aspect", "nearClip", "farClip", "position.x", "position.y",
+                          "position.z", "target.x", "target.y", "target.z", "phi", "theta", "distance",
+                          "minDistance", "maxDistance", "c2w[0][0]", "c2w[0][1]", "c2w[0][2]", "c2w[1][0]",
+                          "c2w[1][1]", "c2w[1][2]", "c2w[2][0]", "c2w[2][1]", "c2w[2][2]", "screenWidth",
+                          "screenHeight", "screenDistance", "focalDistance", "lensRadius"};
+  for (int i = 0; i < 30; ++i) {
+    if (!(in >> v[i]) || !std::isfinite(v[i]))
+      throw std::runtime_error(path + ": camera settings field " + fields[i] + " is missing or not a number");
+  }
+  c.position = Vec3(v[5], v[6], v[7]);
+  c.target = Vec3(v[8], v[9], v[10]);
+  // Rows of the camera-to-world rotation; its columns are right, up, back.
+  c.right = normalize(Vec3(v[16], v[19], v[22]));
+  c.up = normalize(Vec3(v[17], v[20], v[23]));
+  c.back = normalize(Vec3(v[18], v[21], v[24]));
+  if (is_black(c.right) || is_black(c.up) || is_black(c.back))
+    throw std::runtime_error(path + ": camera settings rotation is degenerate");
+  if (!(v[27] > 0)) throw std::runtime_error(path + ": screenDistance must be positive");
+  c.screen_distance = v[27];
+  if (v[3] >= 0 && v[4] > v[3]) {
+    c.tmin = v[3];
+    c.tmax = v[4];
+  }
+}
+
+}  // namespace
+
+Camera make_camera(const SceneDesc& scene, const CameraParams& p) {
+  Camera c;
+  c.width = p.width;
+  c.height = p.height;
+  c.lens_radius = p.lens_radius;
+  c.focal_distance = p.focal_distance;
+
+  if (!p.settings_file.empty()) {
+    read_settings_file(c, p.settings_file);
+  } else if (p.file_camera && scene.camera.present) {
+    const Mat4& m = scene.camera.world;
+    c.position = m.point(Vec3(0, 0, 0));
+    Vec3 r = m.vector(Vec3(1, 0, 0)), u = m.vector(Vec3(0, 1, 0));
+    set_basis(c, m.vector(Vec3(0, 0, 1)), u);
+    if (dot(cross(u, m.vector(Vec3(0, 0, 1))), r) < 0) c.right = -c.right;  // keep handedness as authored
+    float h_fov, v_fov;
+    file_fov(scene, &h_fov, &v_fov);
+    // Authored horizontal FOV spans the output width; the vertical follows the output aspect.
+    c.screen_distance = float(p.width) / (2 * std::tan(h_fov / 2));
+    c.tmin = scene.camera.znear;
+    c.tmax = scene.camera.zfar;
+    c.target = c.position - c.back;
+  } else {
+    // Course framing: orbit the bounding-box centre at 1.5x its diagonal, looking from the
+    // direction of the camera node's matrix applied to the point (0, 0, -1); world up is +Y.
+    float h_fov, v_fov;
+    file_fov(scene, &h_fov, &v_fov);
+    const float aspect = 800.0f / 600.0f;  // the course fits the FOV to its 800x600 screen
+    if (std::tan(h_fov / 2) / std::tan(v_fov / 2) < aspect)
+      h_fov = 2 * std::atan(std::tan(v_fov / 2) * aspect);
+    else
+      v_fov = 2 * std::atan(std::tan(h_fov / 2) / aspect);
+    c.screen_distance = 600.0f / (2 * std::tan(v_fov / 2));
+    Bounds3 b = scene.geometry_bounds();
+    Vec3 target = b.empty() ? Vec3(0.0f) : b.center();
+    float dist = b.empty() ? 1.0f : 1.5f * length(b.diagonal());
+    if (!(dist > 0)) dist = 1;
+    Vec3 dir(0, 0, 1);
+    if (scene.camera.present) {
+      Vec3 d = normalize(scene.camera.world.point(Vec3(0, 0, -1)));
+      if (!is_black(d) && is_finite(d)) dir = d;
+    }
+    c.target = target;
+    c.position = target + dir * dist;
+    set_basis(c, dir, Vec3(0, 1, 0));
+  }
+  // Resizing keeps the angle of a pixel: the FOV follows the output size (course behaviour).
+  c.tan_half_w = (0.5f * p.width) / c.screen_distance;
+  c.tan_half_h = (0.5f * p.height) / c.screen_distance;
+  return c;
+}
+
+Ray Camera::pinhole_ray(float sx, float sy) const {
+  Vec3 dc((2 * sx - 1) * tan_half_w, (2 * sy - 1) * tan_half_h, -1);
+  Ray r;
+  r.o = position;
+  r.d = normalize(right * dc.x + up * dc.y + back * dc.z);
+  r.tmin = tmin;
+  r.tmax = tmax;
+  return r;
+}
+
+Ray Camera::generate_ray(float sx, float sy, Vec2 lens_u) const {
+  if (lens_radius <= 0) return pinhole_ray(sx, sy);
+  // Thin lens: lens disk at z = 0, plane of focus at z = -focal_distance (camera space).
+  Vec3 dc((2 * sx - 1) * tan_half_w, (2 * sy - 1) * tan_half_h, -1);
+  Vec3 focus = dc * focal_distance;
+  Vec2 d = sample_concentric_disk(lens_u);
+  Vec3 lens(lens_radius * d.x, lens_radius * d.y, 0);
+  Vec3 dir = focus - lens;
+  Ray r;
+  r.o = position + right * lens.x + up * lens.y;
+  r.d = normalize(right * dir.x + up * dir.y + back * dir.z);
+  r.tmin = tmin;
+  r.tmax = tmax;
+  return r;
+}
+
+void write_camera_settings(const Camera& c, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write camera settings");
+  float h_fov = 2 * std::atan(c.tan_half_w) / kDeg, v_fov = 2 * std::atan(c.tan_half_h) / kDeg;
+  Vec3 d = c.position - c.target;
+  float dist = length(d);
+  Vec3 dn = dist > 0 ? d / dist : Vec3(0, 0, 1);
+  out << h_fov << " " << v_fov << " " << float(c.width) / c.height << " " << c.tmin << " "
+      << (std::isfinite(c.tmax) ? c.tmax : 1e30f) << "\n";
+  out << c.position.x << " " << c.position.y << " " << c.position.z << " " << c.target.x << " " << c.target.y << " "
+      << c.target.z << "\n";
+  out << std::acos(clampf(dn.y, -1, 1)) << " " << std::atan2(dn.x, dn.z) << " " << dist << " " << dist / 20 << " "
+      << dist * 10 << "\n";
+  out << c.right.x << " " << c.up.x << " " << c.back.x << " " << c.right.y << " " << c.up.y << " " << c.back.y << " "
+      << c.right.z << " " << c.up.z << " " << c.back.z << "\n";
+  out << c.width << " " << c.height << " " << c.screen_distance << "\n";
+  out << c.focal_distance << " " << c.lens_radius << "\n";
+}
+
+}  // namespace pt

@@ -1,0 +1,41 @@
+// Pinhole and thin-lens cameras, placed as the course does (orbiting the scene's bounding box)
+// or as authored in the file, plus the course's camera settings file (-c).
+#pragma once
+
+#include <string>
+
+#include "math.h"
+#include "scene.h"
+
+namespace pt {
+
+struct CameraParams {
+  int width = 800, height = 600;   // full frame in pixels (-r)
+  float lens_radius = 0;           // -b; 0 is a pinhole
+  float focal_distance = 4.7f;     // -d: plane of focus, world units along the view axis
+  bool file_camera = false;        // use the scene file's camera pose and FOV as authored
+  std::string settings_file;       // -c: course camera settings file
+};
+
+struct Camera {
+  Vec3 position;
+  Vec3 right, up, back;            // camera-to-world axes (the camera looks along -back)
+  float tan_half_w = 0, tan_half_h = 0;
+  int width = 800, height = 600;
+  float lens_radius = 0, focal_distance = 1;
+  float tmin = 0, tmax = kInf;
+  float screen_distance = 0;       // pixels, as in the course's settings file
+  Vec3 target;                     // what the course camera orbits (for the settings file)
+
+  // (sx, sy) in [0,1]^2 on the sensor, y up, (0,0) = bottom-left; lens_u picks the lens point.
+  Ray generate_ray(float sx, float sy, Vec2 lens_u) const;
+  // The pinhole ray through the same sensor point (what autofocus casts).
+  Ray pinhole_ray(float sx, float sy) const;
+};
+
+// Builds the camera; throws std::runtime_error naming the settings file on a bad -c file.
+Camera make_camera(const SceneDesc& scene, const CameraParams& params);
+// Writes the course's six-line camera settings file (the window's D key).
+void write_camera_settings(const Camera& camera, const std::string& path);
+
+}  // namespace pt

@@ -1,0 +1,130 @@
+// Flag parsing for the pathtracer command, matching the course's getopt string
+// "s:l:t:m:e:h:H:f:r:c:b:d:a:p:" with its multi-word -r, -a and -p.
+#include "cli.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+namespace pt {
+
+namespace {
+
+long parse_int(const std::string& flag, const std::string& s, long lo, long hi) {
+  char* end = nullptr;
+  errno = 0;
+  long v = std::strtol(s.c_str(), &end, 10);
+  if (s.empty() || *end != '\0' || errno == ERANGE) throw UsageError(flag + ": '" + s + "' is not an integer");
+  if (v < lo || v > hi)
+    throw UsageError(flag + ": " + s + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return v;
+}
+
+float parse_float(const std::string& flag, const std::string& s, double lo, double hi) {
+  char* end = nullptr;
+  errno = 0;
+  double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end != '\0') throw UsageError(flag + ": '" + s + "' is not a number");
+  if (!std::isfinite(v)) throw UsageError(flag + ": '" + s + "' is not finite");
+  if (v < lo || v > hi) throw UsageError(flag + ": " + s + " is out of range");
+  return float(v);
+}
+
+}  // namespace
+
+CliOptions parse_cli(const std::vector<std::string>& args) {
+  CliOptions o;
+  RenderParams& p = o.params;
+  size_t i = 0;
+  auto need = [&](const std::string& flag, size_t count) {
+    if (i + count >= args.size())
+      throw UsageError(flag + " needs " + std::to_string(count) + " value" + (count > 1 ? "s" : ""));
+  };
+  for (i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "-s") { need(a, 1); p.spp = int(parse_int(a, args[++i], 1, 1 << 24)); }
+    else if (a == "-l") { need(a, 1); p.light_samples = int(parse_int(a, args[++i], 1, 65536)); }
+    else if (a == "-t") { need(a, 1); p.threads = int(parse_int(a, args[++i], 1, 1024)); }
+    else if (a == "-m") { need(a, 1); p.max_depth = int(parse_int(a, args[++i], 0, 1000000)); }
+    else if (a == "-e") { need(a, 1); p.env_map = args[++i]; }
+    else if (a == "-b") { need(a, 1); p.lens_radius = parse_float(a, args[++i], 0, 1e6); }
+    else if (a == "-d") { need(a, 1); p.focal_distance = parse_float(a, args[++i], 0, 1e12); }
+    else if (a == "-f") { need(a, 1); o.output = args[++i]; if (o.output.empty()) throw UsageError("-f: empty file name"); }
+    else if (a == "-r") {
+      need(a, 2);
+      p.width = int(parse_int(a, args[++i], 1, 16384));
+      p.height = int(parse_int(a, args[++i], 1, 16384));
+    } else if (a == "-c") { need(a, 1); p.camera_file = args[++i]; }
+    else if (a == "-a") {
+      need(a, 2);
+      p.adaptive = true;
+      p.adaptive_batch = int(parse_int(a, args[++i], 1, 1 << 24));
+      p.adaptive_tolerance = parse_float(a, args[++i], 0, 1e30);
+    } else if (a == "-p") {
+      need(a, 4);
+      p.cell_x = int(parse_int(a, args[++i], 0, 16384));
+      p.cell_y = int(parse_int(a, args[++i], 0, 16384));
+      p.cell_w = int(parse_int(a, args[++i], 1, 16384));
+      p.cell_h = int(parse_int(a, args[++i], 1, 16384));
+    } else if (a == "-H") { p.hemisphere = true; }
+    else if (a == "-h" || a == "--help") { o.help = true; }
+    else if (a == "--no-adaptive") { p.adaptive = false; }
+    else if (a == "--file-camera") { p.file_camera = true; }
+    else if (a == "--seed") { need(a, 1); p.seed = uint64_t(parse_int(a, args[++i], 0, 0x7fffffffffffffffL)); }
+    else if (a == "--tile") { need(a, 1); p.tile_size = int(parse_int(a, args[++i], 1, 4096)); }
+    else if (a == "--quiet") { o.quiet = true; }
+    else if (a.size() > 1 && a[0] == '-') { throw UsageError("unknown option '" + a + "'"); }
+    else {
+      if (!o.scene_path.empty()) throw UsageError("more than one scene file given ('" + o.scene_path + "', '" + a + "')");
+      o.scene_path = a;
+    }
+  }
+  if (o.help) return o;
+  if (o.scene_path.empty()) throw UsageError("no scene file given");
+  try {
+    p.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return o;
+}
+
+std::string usage_text(const std::string& program) {
+  return "Usage: " + program + " [options] <scene.dae>\n"
+"Renders a CS184 COLLADA scene with a Monte Carlo path tracer (Embree 3).\n"
+"\n"
+"Course flags (same meaning as the CS184 pathtracer):\n"
+"  -s <INT>        camera rays (samples) per pixel (default 1; 1 = one ray through the pixel centre)\n"
+"  -l <INT>        samples per area / environment / ambient light (default 1)\n"
+"  -t <INT>        render threads (default 1; more than the cores is fine)\n"
+"  -m <INT>        maximum ray depth (default 1): 0 = emitters only, 1 = direct light,\n"
+"                  each further bounce (specular events included) needs one more level\n"
+"  -e <PATH>       OpenEXR lat-long environment map, importance-sampled\n"
+"  -b <FLOAT>      thin-lens lens radius, the course's 'aperture' (default 0 = pinhole)\n"
+"  -d <FLOAT>      thin-lens focal distance: plane of focus along the view axis (default 4.7)\n"
+"  -f <FILE>       render once to FILE (.png with the course's tone mapping, or .exr linear\n"
+"                  with metadata) plus FILE minus 4 characters + '_rate.png';\n"
+"                  without -f the GLFW debug window opens\n"
+"  -r <W> <H>      output size (default 800 600); keeps the course's pixel angle, so a\n"
+"                  smaller size is a centred crop of the 800x600 view\n"
+"  -c <PATH>       camera settings file (the course's six-line format)\n"
+"  -a <INT> <FLOAT> adaptive sampling batch size and tolerance (default 32 0.05; always on)\n"
+"  -p <x> <y> <dx> <dy> render only this cell (bottom-left origin) and write a dx x dy image\n"
+"  -H              uniform hemisphere sampling for direct lighting instead of light sampling\n"
+"  -h, --help      this text\n"
+"\n"
+"Our options:\n"
+"  --no-adaptive   take exactly -s samples in every pixel\n"
+"  --file-camera   use the scene file's camera pose and field of view as authored instead of\n"
+"                  the course's framing (which orbits the bounding box at 1.5x its diagonal)\n"
+"  --seed <INT>    random seed (default 0); the same seed gives the same image at any -t\n"
+"  --tile <INT>    tile size in pixels (default 32)\n"
+"  --quiet         no progress bar\n";
+}
+
+std::string rate_image_path(const std::string& output) {
+  std::string base = output.size() > 4 ? output.substr(0, output.size() - 4) : output;
+  return base + "_rate.png";
+}
+
+}  // namespace pt

@@ -1,0 +1,122 @@
+// Tone mapping and image I/O (OpenImageIO). Files are written atomically: temp file, then rename.
+#include "image.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <stdexcept>
+
+namespace pt {
+
+namespace OIIO = OIIO_NAMESPACE;
+
+uint8_t tonemap_course(float v) {
+  if (!(v > 0)) return 0;  // also maps NaN to black
+  float t = std::pow(1.41421356f * v, 1.0f / 2.2f);
+  return uint8_t(clampf(t, 0.0f, 1.0f) * 255.0f);
+}
+
+std::vector<uint8_t> to_srgb8_course(const ImageRGB& img) {
+  std::vector<uint8_t> out(img.pixels.size() * 3);
+  for (size_t i = 0; i < img.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = tonemap_course(img.pixels[i][c]);
+  return out;
+}
+
+namespace {
+
+std::string temp_name(const std::string& path) {
+  static std::atomic<int> counter{0};
+  std::string dir, base = path;
+  size_t slash = path.find_last_of('/');
+  if (slash != std::string::npos) {
+    dir = path.substr(0, slash + 1);
+    base = path.substr(slash + 1);
+  }
+  return dir + "." + base + ".tmp" + std::to_string(getpid()) + "-" + std::to_string(counter++);
+}
+
+void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type, const void* data) {
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw std::runtime_error(path + ": cannot write this image format (" + OIIO::geterror() + ")");
+  std::string tmp = temp_name(path);
+  if (!out->open(tmp, spec) || !out->write_image(type, data) || !out->close()) {
+    std::string err = out->geterror();
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot write image: " + err);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot move the finished image into place");
+  }
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  if (s.size() < suffix.size()) return false;
+  for (size_t i = 0; i < suffix.size(); ++i)
+    if (std::tolower((unsigned char)s[s.size() - suffix.size() + i]) != suffix[i]) return false;
+  return true;
+}
+
+}  // namespace
+
+void write_png8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path) {
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  write_atomic(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+}
+
+void write_image(const ImageRGB& img, const std::string& path, const Metadata& meta) {
+  if (ends_with(path, ".exr")) {
+    OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
+    spec.attribute("compression", "zip");
+    for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
+    write_atomic(path, spec, OIIO::TypeDesc::FLOAT, img.pixels.data());
+    return;
+  }
+  std::vector<uint8_t> rgb = to_srgb8_course(img);
+  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
+  for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
+  write_atomic(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+}
+
+std::string encode_png8(const std::vector<uint8_t>& rgb, int width, int height) {
+  std::vector<unsigned char> buffer;
+  OIIO::Filesystem::IOVecOutput vec(buffer);
+  auto out = OIIO::ImageOutput::create("tile.png");
+  if (!out) throw std::runtime_error("PNG encoder unavailable");
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  OIIO::Filesystem::IOProxy* proxy = &vec;
+  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  spec.attribute("png:compressionLevel", 3);
+  if (!out->open("tile.png", spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
+    throw std::runtime_error("PNG encoding failed: " + out->geterror());
+  return std::string(buffer.begin(), buffer.end());
+}
+
+ImageRGB read_image(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw std::runtime_error(path + ": cannot read image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || int64_t(spec.width) * spec.height > (int64_t(1) << 28))
+    throw std::runtime_error(path + ": image size is not usable");
+  std::vector<float> data(size_t(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data()))
+    throw std::runtime_error(path + ": cannot read pixels: " + in->geterror());
+  int ch[3] = {0, spec.nchannels > 1 ? 1 : 0, spec.nchannels > 2 ? 2 : 0};
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < spec.nchannels; ++i)
+      if (spec.channelnames.size() > size_t(i) && spec.channelnames[i] == names[c]) ch[c] = i;
+  ImageRGB img;
+  img.width = spec.width;
+  img.height = spec.height;
+  img.pixels.resize(size_t(spec.width) * spec.height);
+  for (size_t p = 0; p < img.pixels.size(); ++p)
+    img.pixels[p] = Vec3(data[p * spec.nchannels + ch[0]], data[p * spec.nchannels + ch[1]], data[p * spec.nchannels + ch[2]]);
+  return img;
+}
+
+}  // namespace pt

@@ -1,0 +1,34 @@
+// Film images, the course's tone mapping, and all image I/O through OpenImageIO.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "math.h"
+
+namespace pt {
+
+struct ImageRGB {
+  int width = 0, height = 0;
+  std::vector<Vec3> pixels;  // top row first
+  Vec3& at(int x, int y) { return pixels[size_t(y) * width + x]; }
+  const Vec3& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
+};
+
+using Metadata = std::vector<std::pair<std::string, std::string>>;
+
+// The course's look: clamp((sqrt(2) v)^(1/2.2), 0, 1) * 255, truncated.
+uint8_t tonemap_course(float v);
+std::vector<uint8_t> to_srgb8_course(const ImageRGB& img);
+// Writes PNG (course tone mapping, 8-bit) or EXR (linear float + metadata) by extension.
+// Writes go to a temporary file in the same directory, then rename: never a partial file.
+void write_image(const ImageRGB& img, const std::string& path, const Metadata& meta = {});
+// Writes 8-bit RGB rows (top first) as PNG, atomically.
+void write_png8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path);
+// Encodes 8-bit RGB rows as PNG bytes in memory (for streaming tiles).
+std::string encode_png8(const std::vector<uint8_t>& rgb, int width, int height);
+// Reads any image OpenImageIO can read as linear RGB float (top row first); throws on failure.
+ImageRGB read_image(const std::string& path);
+
+}  // namespace pt

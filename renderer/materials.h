@@ -1,0 +1,41 @@
+// BSDFs for the closed set of materials: eval / sample / pdf in a local shading frame.
+//
+// Conventions (used everywhere): the frame's z axis is the shading normal; wo (towards the viewer)
+// and wi (towards the light) both point away from the surface; f(wo, wi) excludes the cosine.
+// For glass and refraction z > 0 is outside (the side the normal points to).
+#pragma once
+
+#include "math.h"
+#include "scene.h"
+
+namespace pt {
+
+struct BsdfSample {
+  Vec3 wi;
+  Vec3 weight;      // f * |cos(wi)| / pdf: what the path throughput is multiplied by
+  float pdf = 0;    // solid-angle pdf, or the discrete lobe probability for delta lobes
+  bool delta = false;
+};
+
+// True when the material has only delta lobes (no eval, no light sampling).
+bool is_delta(const Material& m);
+// True when light can pass through (the frame must not be flipped towards wo).
+bool is_transmissive(const Material& m);
+Vec3 eval_bsdf(const Material& m, Vec3 wo, Vec3 wi);
+float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi);
+// Samples wi given two uniform numbers for the direction and one for the lobe choice.
+bool sample_bsdf(const Material& m, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s);
+// Radiance an emissive surface sends towards wo (local frame; only the front side, wo.z > 0, emits).
+Vec3 emitted_radiance(const Material& m, Vec3 wo);
+bool is_emissive(const Material& m);
+
+// Fresnel reflectance of a dielectric interface for unpolarised light; cos_i on the side of
+// index eta_i. Returns 1 under total internal reflection.
+float fresnel_dielectric(float cos_i, float eta_i, float eta_t);
+// Fresnel reflectance of an air-conductor interface with complex index eta + i k (per channel).
+Vec3 fresnel_conductor(float cos_i, Vec3 eta, Vec3 k);
+// Beckmann normal distribution and Smith shadowing (Walter et al. 2007, eqs. 25 and 27).
+float beckmann_d(Vec3 h, float alpha);
+float smith_lambda_beckmann(Vec3 w, float alpha);
+
+}  // namespace pt

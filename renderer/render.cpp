@@ -1,0 +1,350 @@
+// Render scene construction and the progressive, cancellable session (tiles, passes, adaptive
+// sampling, per-pixel statistics, error estimate). The outer loop belongs to the caller.
+#include "render.h"
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <thread>
+
+#include "materials.h"
+#include "rng.h"
+
+namespace pt {
+
+void RenderParams::validate() const {
+  auto bad = [](const std::string& field, const std::string& why) { throw std::invalid_argument(field + ": " + why); };
+  if (spp < 1 || spp > (1 << 24)) bad("spp (-s)", "must be between 1 and 16777216");
+  if (light_samples < 1 || light_samples > 65536) bad("light_samples (-l)", "must be between 1 and 65536");
+  if (max_depth < 0 || max_depth > 1000000) bad("max_depth (-m)", "must be between 0 and 1000000");
+  if (threads < 1 || threads > 1024) bad("threads (-t)", "must be between 1 and 1024");
+  if (!std::isfinite(lens_radius) || lens_radius < 0 || lens_radius > 1e6f) bad("lens_radius (-b)", "must be finite, >= 0 and <= 1e6");
+  if (!std::isfinite(focal_distance) || focal_distance < 0 || focal_distance > 1e12f)
+    bad("focal_distance (-d)", "must be finite and >= 0");
+  if (width < 1 || height < 1 || width > 16384 || height > 16384) bad("size (-r)", "width and height must be between 1 and 16384");
+  if (adaptive && (adaptive_batch < 1 || !std::isfinite(adaptive_tolerance) || adaptive_tolerance < 0))
+    bad("adaptive (-a)", "batch must be >= 1 and tolerance a finite number >= 0");
+  if (cell_w != 0 || cell_h != 0) {
+    if (cell_w < 1 || cell_h < 1 || cell_x < 0 || cell_y < 0 || cell_x + cell_w > width || cell_y + cell_h > height)
+      bad("cell (-p)", "x y dx dy must lie inside the " + std::to_string(width) + "x" + std::to_string(height) + " frame");
+  }
+  if (tile_size < 1 || tile_size > 4096) bad("tile_size", "must be between 1 and 4096");
+}
+
+std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
+  params.validate();
+  auto rs = std::make_unique<RenderScene>();
+  rs->materials = desc.materials;
+  std::vector<EmitterPanel> panels;
+  std::set<std::string> light_kinds;
+
+  for (const LightDesc& ld : desc.lights) {
+    Light l;
+    l.name = ld.name;
+    l.color = ld.color;
+    if (is_black(ld.color)) {
+      std::fprintf(stderr, "warning: %s: light '%s' has zero colour and is left out\n", desc.source.c_str(), ld.name.c_str());
+      continue;
+    }
+    switch (ld.type) {
+      case LightType::area: {
+        l.kind = LightKind::rect;
+        l.position = ld.position;
+        l.direction = ld.direction;
+        l.dim_x = ld.dim_x;
+        l.dim_y = ld.dim_y;
+        l.area = length(cross(ld.dim_x, ld.dim_y));
+        if (!(l.area > 0) || !std::isfinite(l.area)) {
+          std::fprintf(stderr, "warning: %s: area light '%s' has zero area and is left out\n", desc.source.c_str(), ld.name.c_str());
+          continue;
+        }
+        // The panel is visible to rays and emits on the side it faces.
+        EmitterPanel p;
+        Vec3 c = ld.position, hx = ld.dim_x * 0.5f, hy = ld.dim_y * 0.5f;
+        p.v[0] = c - hx - hy; p.v[1] = c + hx - hy; p.v[2] = c + hx + hy; p.v[3] = c - hx + hy;
+        if (dot(cross(ld.dim_x, ld.dim_y), ld.direction) < 0) std::swap(p.v[1], p.v[3]);
+        Material em;
+        em.name = ld.name + " (panel)";
+        em.type = MaterialType::emission;
+        em.radiance = ld.color;
+        p.material = int(rs->materials.size());
+        rs->materials.push_back(em);
+        p.light = int(rs->lights.size());
+        panels.push_back(p);
+        break;
+      }
+      case LightType::point: l.kind = LightKind::point; l.position = ld.position; break;
+      case LightType::spot:
+        l.kind = LightKind::spot;
+        l.position = ld.position;
+        l.direction = ld.direction;
+        l.cos_cutoff = std::cos(std::min(ld.spot_angle_deg, 360.0f) * 0.5f * kPi / 180);
+        l.exponent = ld.spot_exponent;
+        break;
+      case LightType::directional: l.kind = LightKind::directional; l.direction = ld.direction; break;
+      case LightType::ambient: l.kind = LightKind::ambient; break;
+    }
+    light_kinds.insert(light_kind_name(l.kind));
+    rs->lights.push_back(std::move(l));
+  }
+
+  // Emissive mesh triangles become one mesh light per (mesh, material), sampled by area.
+  std::vector<std::vector<int>> mesh_light(desc.meshes.size());
+  for (size_t mi = 0; mi < desc.meshes.size(); ++mi) {
+    const MeshDesc& mesh = desc.meshes[mi];
+    std::map<int, int> light_of_material;
+    for (size_t t = 0; t < mesh.tri_material.size(); ++t) {
+      int mat = mesh.tri_material[t];
+      if (!is_emissive(rs->materials[mat])) continue;
+      auto it = light_of_material.find(mat);
+      if (it == light_of_material.end()) {
+        Light l;
+        l.kind = LightKind::mesh;
+        l.name = mesh.name;
+        l.color = rs->materials[mat].radiance;
+        it = light_of_material.emplace(mat, int(rs->lights.size())).first;
+        rs->lights.push_back(std::move(l));
+      }
+      Light& l = rs->lights[it->second];
+      for (int k = 0; k < 3; ++k) l.triangles.push_back(mesh.positions[mesh.indices[3 * t + k]]);
+      if (mesh_light[mi].empty()) mesh_light[mi].assign(mesh.tri_material.size(), -1);
+      mesh_light[mi][t] = it->second;
+    }
+  }
+  for (Light& l : rs->lights) {
+    if (l.kind != LightKind::mesh) continue;
+    std::vector<float> areas(l.triangles.size() / 3);
+    double total = 0;
+    for (size_t t = 0; t < areas.size(); ++t) {
+      const Vec3* v = &l.triangles[3 * t];
+      areas[t] = 0.5f * length(cross(v[1] - v[0], v[2] - v[0]));
+      total += areas[t];
+    }
+    l.area = float(total);
+    l.triangle_distribution = Distribution1D(areas);
+    light_kinds.insert("mesh");
+  }
+
+  if (!params.env_map.empty()) {
+    ImageRGB env = read_image(params.env_map);
+    rs->environment = std::make_unique<EnvironmentMap>(env.width, env.height, std::move(env.pixels));
+    Light l;
+    l.kind = LightKind::environment;
+    l.name = params.env_map;
+    l.env = rs->environment.get();
+    rs->environment_light = int(rs->lights.size());
+    rs->lights.push_back(std::move(l));
+    light_kinds.insert("environment");
+  }
+  for (size_t i = 0; i < rs->lights.size(); ++i)
+    if (rs->lights[i].kind == LightKind::ambient || rs->lights[i].kind == LightKind::environment)
+      rs->infinite_lights.push_back(int(i));
+
+  rs->accel = std::make_unique<Accel>(desc, panels, mesh_light);
+
+  CameraParams cp;
+  cp.width = params.width;
+  cp.height = params.height;
+  cp.lens_radius = params.lens_radius;
+  cp.focal_distance = params.focal_distance;
+  cp.file_camera = params.file_camera;
+  cp.settings_file = params.camera_file;
+  rs->camera = make_camera(desc, cp);
+
+  SceneFeatures& f = rs->features;
+  std::set<std::string> mats;
+  for (const MeshDesc& m : desc.meshes)
+    for (int t : m.tri_material) mats.insert(material_type_name(rs->materials[t].type));
+  for (const SphereDesc& s : desc.spheres) mats.insert(material_type_name(rs->materials[s.material].type));
+  if (!panels.empty()) mats.insert("emission");
+  f.materials.assign(mats.begin(), mats.end());
+  f.lights.assign(light_kinds.begin(), light_kinds.end());
+  f.spheres = !desc.spheres.empty();
+  f.meshes = !desc.meshes.empty();
+  f.environment = rs->environment != nullptr;
+  f.thin_lens = params.lens_radius > 0;
+  f.adaptive = params.adaptive && params.spp > params.adaptive_batch;
+  for (const MeshDesc& m : desc.meshes) f.shading_normals |= !m.normals.empty();
+  rs->triangle_count = desc.triangle_count();
+  rs->sphere_count = desc.spheres.size();
+  return rs;
+}
+
+// ---- session ----
+
+RenderSession::RenderSession(const RenderScene& scene, const RenderParams& params) : m_scene(scene), m_params(params) {
+  params.validate();
+  if (params.cell_w > 0) {
+    m_w = params.cell_w;
+    m_h = params.cell_h;
+    m_frame_x0 = params.cell_x;
+    m_frame_y0 = params.height - (params.cell_y + params.cell_h);  // bottom-left origin -> top-left
+  } else {
+    m_w = params.width;
+    m_h = params.height;
+    m_frame_x0 = m_frame_y0 = 0;
+  }
+  size_t n = size_t(m_w) * m_h;
+  m_sum.assign(n, Vec3(0.0f));
+  m_s1.assign(n, 0);
+  m_s2.assign(n, 0);
+  m_count.assign(n, 0);
+  m_done.assign(n, 0);
+  int ts = params.tile_size;
+  for (int y = 0; y < m_h; y += ts)
+    for (int x = 0; x < m_w; x += ts) m_tiles.push_back({x, y, std::min(x + ts, m_w), std::min(y + ts, m_h)});
+}
+
+void RenderSession::render_tile(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,
+                                uint64_t& samples, uint64_t& nonfinite) {
+  const RenderParams& p = m_params;
+  const Camera& cam = m_scene.camera;
+  const bool adaptive = p.adaptive;
+  const int batch = std::max(1, p.adaptive_batch);
+  for (int y = t.y0; y < t.y1; ++y) {
+    if (cancel && cancel->load(std::memory_order_relaxed)) return;
+    for (int x = t.x0; x < t.x1; ++x) {
+      size_t i = size_t(y) * m_w + x;
+      if (m_done[i]) continue;
+      int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
+      int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
+      uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
+      uint32_t before = m_count[i];
+      while (m_count[i] < uint32_t(target)) {
+        uint32_t s = m_count[i];
+        if ((s & 15) == 15 && cancel && cancel->load(std::memory_order_relaxed)) break;
+        Pcg32 rng = make_sample_rng(p.seed, pixel_index, s);
+        Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
+        Vec2 lens = rng.next_2d();
+        Ray ray = cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
+        Vec3 l = trace_path(m_scene, p, ray, rng, rays);
+        if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
+          ++nonfinite;
+          l = Vec3(0.0f);
+        }
+        m_sum[i] += l;
+        double lum = luminance(l);
+        m_s1[i] += lum;
+        m_s2[i] += lum * lum;
+        uint32_t n = ++m_count[i];
+        ++samples;
+        // Course adaptive sampling: after sample index n-1 > 0 that is a multiple of the batch,
+        // stop once the 95% confidence half-width is within tolerance x mean.
+        if (adaptive && n > 1 && (n - 1) % batch == 0) {
+          double mu = m_s1[i] / n;
+          double var = std::max(0.0, (m_s2[i] - m_s1[i] * m_s1[i] / n) / (n - 1));
+          if (1.96 * std::sqrt(var / n) <= p.adaptive_tolerance * mu) {
+            m_done[i] = 1;
+            break;
+          }
+        }
+      }
+      if (m_count[i] >= uint32_t(p.spp)) m_done[i] = 1;
+      uint64_t credit = m_done[i] ? uint64_t(p.spp) - before : uint64_t(m_count[i] - before);
+      m_budget_done.fetch_add(credit, std::memory_order_relaxed);
+    }
+  }
+}
+
+bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel, const TileCallback& on_tile) {
+  target_spp = std::min(target_spp, m_params.spp);
+  auto start = std::chrono::steady_clock::now();
+  std::atomic<size_t> next{0};
+  auto worker = [&]() {
+    uint64_t rays = 0, samples = 0, nonfinite = 0;
+    for (;;) {
+      size_t ti = next.fetch_add(1);
+      if (ti >= m_tiles.size()) break;
+      if (cancel && cancel->load()) break;
+      render_tile(m_tiles[ti], target_spp, cancel, rays, samples, nonfinite);
+      if (on_tile && !(cancel && cancel->load())) on_tile(m_tiles[ti]);
+    }
+    m_rays += rays;
+    m_samples += samples;
+    m_nonfinite += nonfinite;
+  };
+  int nthreads = std::max(1, std::min<int>(m_params.threads, int(m_tiles.size())));
+  std::vector<std::thread> pool;
+  for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  m_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ++m_passes;
+  return !(cancel && cancel->load());
+}
+
+bool RenderSession::render_all(const std::atomic<bool>* cancel, const std::function<void()>& on_progress) {
+  int target = 1;
+  while (!finished()) {
+    if (!render_pass(target, cancel, on_progress ? TileCallback([&](const Tile&) { on_progress(); }) : TileCallback()))
+      return false;
+    if (target >= m_params.spp) break;
+    target = std::min(m_params.spp, target * 2);
+  }
+  return true;
+}
+
+bool RenderSession::finished() const {
+  for (uint8_t d : m_done)
+    if (!d) return false;
+  return true;
+}
+
+double RenderSession::progress() const {
+  double total = double(m_params.spp) * m_w * m_h;
+  return total > 0 ? std::min(1.0, double(m_budget_done.load()) / total) : 1.0;
+}
+
+ImageRGB RenderSession::image() const {
+  ImageRGB img;
+  img.width = m_w;
+  img.height = m_h;
+  img.pixels.resize(m_sum.size());
+  for (size_t i = 0; i < m_sum.size(); ++i) img.pixels[i] = m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f);
+  return img;
+}
+
+ImageRGB RenderSession::rate_image() const {
+  // Course colouring: 0 = blue, 0.5 = green, 1 = red, by samples taken / spp.
+  ImageRGB img;
+  img.width = m_w;
+  img.height = m_h;
+  img.pixels.resize(m_sum.size());
+  for (size_t i = 0; i < m_sum.size(); ++i) {
+    float r = float(m_count[i]) / float(m_params.spp);
+    Vec3 c = r <= 0.5f ? Vec3(0, 2 * r, 1 - 2 * r) : Vec3(2 * r - 1, 2 - 2 * r, 0);
+    img.pixels[i] = c;
+  }
+  return img;
+}
+
+double RenderSession::error_estimate() const {
+  // Relative MSE of the pixel means, estimated from their own sample variance:
+  // mean over pixels of Var[mean] / (mean^2 + eps), eps keeping black pixels finite
+  // (relMSE as in Rousselle et al. 2011 / Bitterli's benchmarks).
+  double sum = 0;
+  size_t n = 0;
+  for (size_t i = 0; i < m_count.size(); ++i) {
+    uint32_t c = m_count[i];
+    if (c < 2) continue;
+    double mu = m_s1[i] / c;
+    double var = std::max(0.0, (m_s2[i] - m_s1[i] * m_s1[i] / c) / (c - 1));
+    sum += (var / c) / (mu * mu + 1e-2);
+    ++n;
+  }
+  return n ? sum / double(m_count.size()) : INFINITY;
+}
+
+SessionStats RenderSession::stats() const {
+  SessionStats s;
+  s.samples = m_samples.load();
+  s.rays = m_rays.load();
+  s.nonfinite = m_nonfinite.load();
+  s.seconds = m_seconds;
+  s.passes = m_passes;
+  return s;
+}
+
+}  // namespace pt

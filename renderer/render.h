@@ -1,0 +1,120 @@
+// RenderParams (the one source of render options), the render scene built from a SceneDesc, and
+// the progressive, cancellable render session that the CLI, the server and the window share.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "accel.h"
+#include "camera.h"
+#include "image.h"
+#include "lights.h"
+#include "scene.h"
+
+namespace pt {
+
+struct RenderParams {
+  int spp = 1;                     // -s: camera rays per pixel
+  int light_samples = 1;           // -l: samples per area / environment / ambient light
+  int max_depth = 1;               // -m: maximum ray depth (bounces; each specular event uses one)
+  int threads = 1;                 // -t
+  float lens_radius = 0;           // -b (the course calls it aperture)
+  float focal_distance = 4.7f;     // -d
+  int width = 800, height = 600;   // -r
+  bool adaptive = true;            // -a: on by default, as in the course
+  int adaptive_batch = 32;
+  float adaptive_tolerance = 0.05f;
+  bool hemisphere = false;         // -H: uniform hemisphere direct lighting
+  std::string env_map;             // -e: lat-long OpenEXR environment
+  std::string camera_file;         // -c
+  bool file_camera = false;        // --file-camera: the scene's camera as authored
+  int cell_x = 0, cell_y = 0, cell_w = 0, cell_h = 0;  // -p: window, bottom-left origin; w = 0: full frame
+  uint64_t seed = 0;               // --seed
+  int tile_size = 32;
+
+  // Throws std::invalid_argument naming the field when a value is out of range.
+  void validate() const;
+};
+
+struct SceneFeatures {
+  std::vector<std::string> materials, lights;
+  bool spheres = false, meshes = false, environment = false, thin_lens = false;
+  bool adaptive = false, shading_normals = false;
+};
+
+struct RenderScene {
+  std::vector<Material> materials;
+  std::vector<Light> lights;
+  std::vector<int> infinite_lights;  // ambient / environment, looked up when rays escape
+  int environment_light = -1;        // visible to camera rays
+  std::unique_ptr<EnvironmentMap> environment;
+  std::unique_ptr<Accel> accel;
+  Camera camera;
+  SceneFeatures features;
+  size_t triangle_count = 0, sphere_count = 0;
+};
+
+// Builds what the integrator needs from the file's description: lights (area lights also as
+// visible panels, emissive meshes as mesh lights), the environment map, the camera, the BVH.
+std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params);
+
+// One camera path's radiance (integrator.cpp). `rays` counts every ray cast.
+Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, class Pcg32& rng, uint64_t& rays);
+
+struct Tile {
+  int x0, y0, x1, y1;  // film pixels, top-left origin, half-open
+};
+
+struct SessionStats {
+  uint64_t samples = 0, rays = 0, nonfinite = 0;
+  double seconds = 0;
+  int passes = 0;
+};
+
+class RenderSession {
+ public:
+  RenderSession(const RenderScene& scene, const RenderParams& params);
+
+  // Advances every unfinished pixel to `target_spp` samples (adaptive pixels may stop early).
+  // `on_tile` runs on worker threads after each finished tile. Returns false if cancelled.
+  using TileCallback = std::function<void(const Tile&)>;
+  bool render_pass(int target_spp, const std::atomic<bool>* cancel = nullptr, const TileCallback& on_tile = {});
+  // Renders passes of doubling size up to params.spp; `on_pass` after each pass.
+  bool render_all(const std::atomic<bool>* cancel = nullptr, const std::function<void()>& on_progress = {});
+
+  int width() const { return m_w; }
+  int height() const { return m_h; }
+  bool finished() const;
+  // Fraction of the sample budget done (converged pixels count as complete).
+  double progress() const;
+  ImageRGB image() const;        // mean radiance per pixel
+  ImageRGB rate_image() const;   // the course's sample-rate colouring
+  // Estimated relative MSE of the image from per-pixel sample variance (no reference needed).
+  double error_estimate() const;
+  SessionStats stats() const;
+  const std::vector<Tile>& tiles() const { return m_tiles; }
+
+ private:
+  void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
+                   uint64_t& samples, uint64_t& nonfinite);
+
+  const RenderScene& m_scene;
+  RenderParams m_params;
+  int m_w, m_h;            // film size (the cell for -p)
+  int m_frame_x0, m_frame_y0;  // film origin inside the full frame, top-left
+  std::vector<Tile> m_tiles;
+  std::vector<Vec3> m_sum;
+  std::vector<double> m_s1, m_s2;   // luminance sums for adaptive sampling and error estimates
+  std::vector<uint32_t> m_count;
+  std::vector<uint8_t> m_done;
+  std::atomic<uint64_t> m_samples{0}, m_rays{0}, m_nonfinite{0};
+  std::atomic<uint64_t> m_budget_done{0};  // pixel-samples done, converged pixels counted in full
+  double m_seconds = 0;
+  int m_passes = 0;
+};
+
+}  // namespace pt
