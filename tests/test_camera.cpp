@@ -1,0 +1,176 @@
+// Camera placement (course framing, authored, settings file) and thin-lens geometry.
+#include "camera.h"
+
+#include <gtest/gtest.h>
+
+#include "collada.h"
+#include "rng.h"
+#include "test_util.h"
+
+using namespace pt;
+
+namespace {
+
+// A scene with one box from (-1,0,-1) to (1,1.5,1) and the course's Cornell-box camera node.
+SceneDesc box_scene() {
+  SceneDesc s;
+  MeshDesc m;
+  m.positions = {{-1, 0, -1}, {1, 0, -1}, {1, 1.5f, 1}};
+  m.indices = {0, 1, 2};
+  m.tri_material = {0};
+  s.meshes.push_back(m);
+  s.materials.push_back(Material());
+  s.camera.present = true;
+  s.camera.xfov_deg = 49.13434f;
+  s.camera.aspect = 1.333333f;
+  s.camera.znear = 0.1f;
+  s.camera.zfar = 100;
+  // Course camera matrix (Z-up file) with the Z_UP conversion applied on top.
+  Mat4 file = Mat4::zero();
+  double v[16] = {-1, 0, 0, 0, 0, 0, 1, 3, 0, 1, 0, 0, 0, 0, 0, 1};
+  for (int i = 0; i < 16; ++i) file.m[i / 4][i % 4] = v[i];
+  Mat4 up = Mat4::zero();
+  up.m[0][0] = -1; up.m[1][2] = 1; up.m[2][1] = 1; up.m[3][3] = 1;
+  s.camera.world = up * file;
+  return s;
+}
+
+float dist(Vec3 a, Vec3 b) { return length(a - b); }
+
+}  // namespace
+
+TEST(Camera, CourseFramingOrbitsTheBoundingBox) {
+  SceneDesc s = box_scene();
+  Camera c = make_camera(s, CameraParams());
+  // Centre (0, 0.75, 0), diagonal sqrt(4 + 2.25 + 4) = 3.2016, distance 1.5 x that = 4.802.
+  EXPECT_NEAR(c.position.x, 0, 1e-5);
+  EXPECT_NEAR(c.position.y, 0.75, 1e-5);
+  EXPECT_NEAR(c.position.z, 1.5 * std::sqrt(10.25), 1e-4);
+  Ray r = c.pinhole_ray(0.5f, 0.5f);
+  EXPECT_NEAR(r.d.z, -1, 1e-6);
+}
+
+TEST(Camera, ResizeKeepsThePixelAngle) {
+  SceneDesc s = box_scene();
+  CameraParams p;
+  Camera full = make_camera(s, p);
+  p.width = 400;
+  p.height = 300;
+  Camera half = make_camera(s, p);
+  EXPECT_NEAR(half.tan_half_w, full.tan_half_w / 2, 1e-6);
+  EXPECT_NEAR(half.tan_half_h, full.tan_half_h / 2, 1e-6);
+  // The centre pixel of the crop sees what the centre pixel of the full frame sees.
+  Ray a = full.pinhole_ray(0.5f, 0.5f), b = half.pinhole_ray(0.5f, 0.5f);
+  EXPECT_LT(dist(a.d, b.d), 1e-6);
+  // The 800x600 fit: 49.13 degree xfov at 4:3 gives the vertical 600 px span.
+  EXPECT_NEAR(std::atan(full.tan_half_w) * 2 * 180 / kPi, 49.13434, 0.01);
+}
+
+TEST(Camera, ThinLensRaysFromOnePixelMeetOnTheFocalPlane) {
+  SceneDesc s = box_scene();
+  CameraParams p;
+  p.lens_radius = 0.25f;
+  p.focal_distance = 3.0f;
+  Camera c = make_camera(s, p);
+  Vec3 view = -c.back;
+  for (Vec2 px : {Vec2{0.5f, 0.5f}, Vec2{0.1f, 0.8f}, Vec2{0.93f, 0.07f}}) {
+    Vec3 first;
+    Pcg32 rng(7, 1);
+    for (int k = 0; k < 64; ++k) {
+      Ray r = c.generate_ray(px.x, px.y, rng.next_2d());
+      // Lens origins lie on the lens disk of the given radius around the camera.
+      EXPECT_LE(dist(r.o, c.position), p.lens_radius * 1.0001f);
+      EXPECT_NEAR(dot(r.o - c.position, view), 0, 1e-5);
+      float t = (p.focal_distance - dot(r.o - c.position, view)) / dot(r.d, view);
+      Vec3 hit = r.o + r.d * t;
+      if (k == 0) first = hit;
+      else EXPECT_LT(dist(hit, first), 2e-5f) << "pixel " << px.x << "," << px.y;
+    }
+    // ... and that point is where the pinhole ray through the pixel crosses the plane.
+    Ray pin = c.pinhole_ray(px.x, px.y);
+    Vec3 on_plane = pin.o + pin.d * (p.focal_distance / dot(pin.d, view));
+    EXPECT_LT(dist(on_plane, first), 2e-5f);
+  }
+}
+
+TEST(Camera, ZeroLensRadiusIsExactlyThePinhole) {
+  SceneDesc s = box_scene();
+  CameraParams p;
+  p.lens_radius = 0;
+  Camera c = make_camera(s, p);
+  Pcg32 rng(3, 4);
+  for (int k = 0; k < 16; ++k) {
+    Vec2 px = rng.next_2d();
+    Ray a = c.generate_ray(px.x, px.y, rng.next_2d()), b = c.pinhole_ray(px.x, px.y);
+    EXPECT_EQ(a.o, b.o);
+    EXPECT_EQ(a.d, b.d);
+  }
+}
+
+TEST(Camera, FileCameraUsesTheAuthoredPose) {
+  SceneDesc s = box_scene();
+  CameraParams p;
+  p.file_camera = true;
+  Camera c = make_camera(s, p);
+  // Course matrix: camera at z = 3 (Z-up file) -> (0, 0, 3) Y-up... translation (0, 3, 0) in
+  // the file maps to (-0, 0, 3); it looks along the file's -z axis mapped to Y-up.
+  EXPECT_NEAR(c.position.z, 3, 1e-5);
+  EXPECT_NEAR(c.position.y, 0, 1e-5);
+  Ray r = c.pinhole_ray(0.5f, 0.5f);
+  EXPECT_NEAR(r.d.z, -1, 1e-5);
+  EXPECT_NEAR(std::atan(c.tan_half_w) * 2 * 180 / kPi, 49.13434, 0.01);
+  EXPECT_FLOAT_EQ(c.tmin, 0.1f);
+  EXPECT_FLOAT_EQ(c.tmax, 100.0f);
+}
+
+TEST(Camera, SettingsFileRoundTrip) {
+  SceneDesc s = box_scene();
+  CameraParams p;
+  p.width = 320;
+  p.height = 200;
+  Camera a = make_camera(s, p);
+  std::string path = test::temp_dir() + "/cam_settings.txt";
+  write_camera_settings(a, path);
+  p.settings_file = path;
+  Camera b = make_camera(s, p);
+  for (Vec2 px : {Vec2{0.5f, 0.5f}, Vec2{0.0f, 1.0f}, Vec2{0.7f, 0.2f}}) {
+    Ray ra = a.pinhole_ray(px.x, px.y), rb = b.pinhole_ray(px.x, px.y);
+    EXPECT_LT(dist(ra.o, rb.o), 1e-4f);
+    EXPECT_LT(dist(ra.d, rb.d), 1e-4f);
+  }
+}
+
+TEST(Camera, BadSettingsFileNamesTheField) {
+  std::string path = test::temp_dir() + "/cam_bad.txt";
+  FILE* f = std::fopen(path.c_str(), "w");
+  std::fputs("30 20 1.5 0.1 100\n0 0 0 1 1 1\n1 2 oops\n", f);
+  std::fclose(f);
+  CameraParams p;
+  p.settings_file = path;
+  try {
+    make_camera(box_scene(), p);
+    FAIL() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("cam_bad.txt"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("distance"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Camera, CBdragonDefaultFocusIsOnTheDragon) {
+  PT_REQUIRE_SHARED_SCENE(path, "CBdragon.dae");
+  SceneDesc s = load_collada(path);
+  Camera c = make_camera(s, CameraParams());
+  // The dragon's nearest and farthest points along the view axis bracket the course's -d 4.5.
+  Vec3 view = -c.back;
+  float lo = kInf, hi = -kInf;
+  for (const MeshDesc& m : s.meshes) {
+    if (m.indices.size() < 3000) continue;  // the box walls and light quad are small meshes
+    for (const Vec3& v : m.positions) {
+      float z = dot(v - c.position, view);
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+    }
+  }
+  EXPECT_LT(lo, 4.5f);
+  EXPECT_GT(hi, 4.5f);
+}

@@ -1,0 +1,187 @@
+// The pathtracer command: course flags parse unchanged, bad flags are named, and the real
+// binary writes its images (PNG + _rate.png, EXR with metadata) or fails with a located error.
+#include "cli.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <OpenImageIO/imageio.h>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "test_util.h"
+
+using namespace pt;
+
+namespace {
+
+std::vector<std::string> split(const std::string& s) {
+  std::istringstream in(s);
+  std::vector<std::string> out;
+  std::string w;
+  while (in >> w) out.push_back(w);
+  return out;
+}
+
+struct RunResult {
+  int status;
+  std::string output;
+};
+
+RunResult run(const std::string& args) {
+  std::string cmd = std::string(PT_PATHTRACER) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+const char* kTinyScene = R"(<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><up_axis>Y_UP</up_axis></asset>
+  <library_lights><light id="L"><technique_common><point><color>4 4 4</color>
+    <constant_attenuation>1</constant_attenuation><linear_attenuation>0</linear_attenuation>
+    <quadratic_attenuation>0</quadratic_attenuation></point></technique_common></light></library_lights>
+  <library_geometries>
+    <geometry id="S"><extra><technique profile="CGL"><sphere><radius>1</radius></sphere></technique></extra></geometry>
+  </library_geometries>
+  <library_visual_scenes><visual_scene id="VS">
+    <node id="l"><translate>0 3 3</translate><instance_light url="#L"/></node>
+    <node id="s"><instance_geometry url="#S"/></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#VS"/></scene>
+</COLLADA>
+)";
+
+std::string write_tiny_scene() {
+  std::string path = test::temp_dir() + "/tiny.dae";
+  std::ofstream(path) << kTinyScene;
+  return path;
+}
+
+}  // namespace
+
+TEST(Cli, CourseCommandsParseUnchanged) {
+  CliOptions o = parse_cli(split("-t 8 -s 64 -l 4 -m 5 -r 480 360 -f p1_5.png CBspheres.dae"));
+  EXPECT_EQ(o.params.threads, 8);
+  EXPECT_EQ(o.params.spp, 64);
+  EXPECT_EQ(o.params.light_samples, 4);
+  EXPECT_EQ(o.params.max_depth, 5);
+  EXPECT_EQ(o.params.width, 480);
+  EXPECT_EQ(o.params.height, 360);
+  EXPECT_EQ(o.output, "p1_5.png");
+  EXPECT_EQ(o.scene_path, "CBspheres.dae");
+  EXPECT_TRUE(o.params.adaptive);  // on by default, as in the course
+
+  o = parse_cli(split("-t 8 -s 128 -a 64 0.05 -r 480 360 -m 12 -l 4 -b 0.23 -d 4.5 -f focus.png CBdragon.dae"));
+  EXPECT_EQ(o.params.adaptive_batch, 64);
+  EXPECT_FLOAT_EQ(o.params.adaptive_tolerance, 0.05f);
+  EXPECT_EQ(o.params.max_depth, 12);
+  EXPECT_FLOAT_EQ(o.params.lens_radius, 0.23f);
+  EXPECT_FLOAT_EQ(o.params.focal_distance, 4.5f);
+
+  o = parse_cli(split("-H -p 10 20 30 40 -c cam.txt -e env.exr s.dae"));
+  EXPECT_TRUE(o.params.hemisphere);
+  EXPECT_EQ(o.params.cell_x, 10);
+  EXPECT_EQ(o.params.cell_h, 40);
+  EXPECT_EQ(o.params.camera_file, "cam.txt");
+  EXPECT_EQ(o.params.env_map, "env.exr");
+  EXPECT_TRUE(o.output.empty());
+}
+
+TEST(Cli, DefaultsMatchTheCourse) {
+  CliOptions o = parse_cli(split("scene.dae"));
+  EXPECT_EQ(o.params.spp, 1);
+  EXPECT_EQ(o.params.light_samples, 1);
+  EXPECT_EQ(o.params.max_depth, 1);
+  EXPECT_EQ(o.params.threads, 1);
+  EXPECT_FLOAT_EQ(o.params.lens_radius, 0);
+  EXPECT_FLOAT_EQ(o.params.focal_distance, 4.7f);
+  EXPECT_EQ(o.params.width, 800);
+  EXPECT_EQ(o.params.height, 600);
+  EXPECT_EQ(o.params.adaptive_batch, 32);
+  EXPECT_FLOAT_EQ(o.params.adaptive_tolerance, 0.05f);
+}
+
+TEST(Cli, BadFlagsAreNamed) {
+  struct Case {
+    const char* args;
+    const char* names;
+  } cases[] = {
+      {"-s abc s.dae", "-s"},         {"-s 0 s.dae", "-s"},          {"-m -1 s.dae", "-m"},
+      {"-r 480 s.dae", "-r"},         {"-b nan s.dae", "-b"},        {"-d inf s.dae", "-d"},
+      {"-b -1 s.dae", "-b"},          {"-x s.dae", "-x"},            {"-p 0 0 900 10 s.dae", "cell"},
+      {"-f", "-f"},                   {"", "scene"},                 {"a.dae b.dae", "more than one"},
+      {"-a 0 0.05 s.dae", "-a"},      {"-t 0 s.dae", "-t"},          {"-l 99999999999 s.dae", "-l"},
+  };
+  for (const Case& c : cases) {
+    try {
+      parse_cli(split(c.args));
+      ADD_FAILURE() << "accepted: " << c.args;
+    } catch (const UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.names), std::string::npos) << c.args << " -> " << e.what();
+    }
+  }
+}
+
+TEST(Cli, RateImageName) {
+  EXPECT_EQ(rate_image_path("out/p1_5.png"), "out/p1_5_rate.png");
+  EXPECT_EQ(rate_image_path("x.exr"), "x_rate.png");
+}
+
+TEST(Cli, HelpDocumentsEveryFlag) {
+  RunResult r = run("--help");
+  EXPECT_EQ(r.status, 0);
+  for (const char* f : {"-s ", "-l ", "-t ", "-m ", "-e ", "-b ", "-d ", "-f ", "-r ", "-c ", "-a ", "-p ", "-H ",
+                        "-h", "--file-camera", "--seed", "--no-adaptive"})
+    EXPECT_NE(r.output.find(f), std::string::npos) << f;
+}
+
+TEST(Cli, RendersPngRateImageAndExrWithMetadata) {
+  std::string scene = write_tiny_scene();
+  std::string dir = test::temp_dir();
+  RunResult r = run("-t 3 -s 4 -m 2 -r 64 48 --quiet -f " + dir + "/tiny.png " + scene);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("rays/s"), std::string::npos) << r.output;
+  for (const char* name : {"/tiny.png", "/tiny_rate.png"}) {
+    auto in = OIIO::ImageInput::open(dir + name);
+    ASSERT_TRUE(in) << name;
+    EXPECT_EQ(in->spec().width, 64);
+    EXPECT_EQ(in->spec().height, 48);
+  }
+  r = run("-s 4 -m 2 -r 64 48 --seed 5 --quiet -f " + dir + "/tiny.exr " + scene);
+  ASSERT_EQ(r.status, 0) << r.output;
+  auto in = OIIO::ImageInput::open(dir + "/tiny.exr");
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::FLOAT);
+  EXPECT_EQ(in->spec().get_string_attribute("pathtracer:seed"), "5");
+  EXPECT_EQ(in->spec().get_string_attribute("pathtracer:max_depth"), "2");
+  EXPECT_EQ(in->spec().get_string_attribute("pathtracer:nonfinite_samples"), "0");
+  EXPECT_FALSE(in->spec().get_string_attribute("pathtracer:wall_seconds").empty());
+  EXPECT_FALSE(in->spec().get_string_attribute("pathtracer:achieved_spp").empty());
+}
+
+TEST(Cli, BadSceneFailsWithALocatedMessage) {
+  std::string path = test::temp_dir() + "/broken.dae";
+  std::ofstream(path) << "<COLLADA><asset><up_axis>W_UP</up_axis></asset></COLLADA>";
+  RunResult r = run("--quiet -f " + test::temp_dir() + "/never.png " + path);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("broken.dae:1"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("up_axis"), std::string::npos) << r.output;
+  EXPECT_FALSE(test::file_exists(test::temp_dir() + "/never.png"));
+
+  r = run("--quiet -f " + test::temp_dir() + "/never.png /nonexistent/scene.dae");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("/nonexistent/scene.dae"), std::string::npos) << r.output;
+}
+
+TEST(Cli, MoreThreadsThanCoresStillWork) {
+  std::string scene = write_tiny_scene();
+  RunResult r = run("-t 64 -s 2 -r 40 30 --quiet -f " + test::temp_dir() + "/many.png " + scene);
+  EXPECT_EQ(r.status, 0) << r.output;
+}

@@ -1,0 +1,62 @@
+// Helpers shared by the tests: scene paths (skipping cleanly without ../shared), temp dirs,
+// and noise-aware image statistics.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cmath>
+#include <string>
+
+#include "image.h"
+
+namespace pt::test {
+
+inline bool file_exists(const std::string& p) {
+  struct stat st;
+  return stat(p.c_str(), &st) == 0;
+}
+
+// Path of a course scene in ../shared/scenes-cs184, or "" when it is absent.
+inline std::string shared_scene(const std::string& name) {
+  std::string p = std::string(PT_SHARED_SCENES) + "/" + name;
+  return file_exists(p) ? p : "";
+}
+
+#define PT_REQUIRE_SHARED_SCENE(var, name)                                      \
+  std::string var = ::pt::test::shared_scene(name);                             \
+  if (var.empty()) GTEST_SKIP() << "../shared/scenes-cs184/" << name << " is absent"
+
+inline std::string own_scene(const std::string& name) { return std::string(PT_OWN_SCENES) + "/" + name; }
+
+inline std::string temp_dir() {
+  std::string d = PT_TEST_TMP;
+  mkdir(d.c_str(), 0755);
+  return d;
+}
+
+// Mean and standard error of the luminance over a pixel rectangle [x0,x1) x [y0,y1).
+struct RegionStats {
+  double mean = 0, stderr_ = 0;
+  int n = 0;
+};
+inline RegionStats region_stats(const ImageRGB& img, int x0, int y0, int x1, int y1, int channel = -1) {
+  double s = 0, s2 = 0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const Vec3& c = img.at(x, y);
+      double v = channel < 0 ? luminance(c) : c[channel];
+      s += v;
+      s2 += v * v;
+      ++n;
+    }
+  RegionStats r;
+  r.n = n;
+  r.mean = n ? s / n : 0;
+  double var = n > 1 ? std::max(0.0, (s2 - s * s / n) / (n - 1)) : 0;
+  r.stderr_ = n ? std::sqrt(var / n) : 0;
+  return r;
+}
+
+}  // namespace pt::test
