@@ -289,7 +289,8 @@ void Reader::read_camera(const pugi::xml_node& inst, const Mat4& world) {
   c.aspect = float(scalar_or(persp, "aspect_ratio", 0));
   if (c.xfov_deg == 0 && c.yfov_deg == 0) c.xfov_deg = 50;
   if (c.yfov_deg == 0 && c.aspect <= 0) fail(persp, "needs <yfov> or <aspect_ratio>");
-  if (c.xfov_deg == 0 && c.aspect <= 0) fail(persp, "needs <xfov> or <aspect_ratio>");
+  // yfov alone is valid COLLADA (the course rejects only a camera with neither yfov nor aspect_ratio):
+  // xfov stays 0 and the camera derives it from yfov and the image aspect.
   for (float f : {c.xfov_deg, c.yfov_deg})
     if (f < 0 || f >= 180) fail(persp, "field of view must be in (0, 180) degrees");
   c.znear = float(scalar_or(persp, "znear", 0.001));
@@ -341,7 +342,9 @@ void Reader::read_light(const pugi::xml_node& inst, const Mat4& world) {
     if (length(l.direction) == 0) fail(kind, "spot light transform is degenerate");
   } else if (type == "directional") {
     l.type = LightType::directional;
-    l.direction = normalize(world.vector(Vec3(0, 0, -1)));
+    // The course takes M * (0,0,-1) as the direction towards the light (cs184-spec (c); cow.dae is lit
+    // from above), so light travels the opposite way; the translation the course folds in is dropped.
+    l.direction = -normalize(world.vector(Vec3(0, 0, -1)));
     if (length(l.direction) == 0) fail(kind, "directional light transform is degenerate");
   } else if (type == "ambient") {
     l.type = LightType::ambient;

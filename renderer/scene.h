@@ -56,7 +56,7 @@ struct SphereDesc {
 
 struct CameraDesc {
   bool present = false;
-  float xfov_deg = 50, yfov_deg = 0;  // yfov 0 means derived from xfov and aspect
+  float xfov_deg = 50, yfov_deg = 0;  // 0 means derived from the other one and the aspect ratio
   float aspect = 0;
   float znear = 0.001f, zfar = 1000;
   Mat4 world;  // camera-to-world, after the up-axis conversion
