@@ -29,6 +29,8 @@ bool is_transmissive(const Material& m) {
 bool is_emissive(const Material& m) { return m.type == MaterialType::emission && !is_black(m.radiance); }
 
 float fresnel_dielectric(float cos_i, float eta_i, float eta_t) {
+  // Index-matched: no interface. (Otherwise 1 - cos^2 rounds to 1 near grazing and reads as TIR.)
+  if (eta_i == eta_t) return 0;
   cos_i = clampf(std::fabs(cos_i), 0.0f, 1.0f);
   float eta = eta_i / eta_t;
   float sin2_t = eta * eta * (1 - cos_i * cos_i);
@@ -55,8 +57,8 @@ Vec3 fresnel_conductor(float cos_i, Vec3 eta, Vec3 k) {
 }
 
 float beckmann_d(Vec3 h, float alpha) {
+  if (h.z <= 0) return 0;  // the chi+(h.n) factor of eq. 25: no back-facing microfacets
   float cos2 = h.z * h.z;
-  if (cos2 <= 0) return 0;
   float tan2 = (1 - cos2) / cos2;
   float a2 = alpha * alpha;
   float d = std::exp(-tan2 / a2) / (kPi * a2 * cos2 * cos2);
@@ -68,7 +70,8 @@ float smith_lambda_beckmann(Vec3 w, float alpha) {
   if (sin2 == 0) return 0;
   float a = std::fabs(w.z) / (alpha * std::sqrt(sin2));  // 1 / (alpha tan theta)
   if (a > 8) return 0;                                  // Lambda underflows: no shadowing
-  return 0.5f * (std::erf(a) - 1 + std::exp(-a * a) / (a * std::sqrt(kPi)));
+  // erf(a) - 1 = -erfc(a): in float, erf(a) - 1 cancels to noise (even negative) from a ~ 3.
+  return 0.5f * (std::exp(-a * a) / (a * std::sqrt(kPi)) - std::erfc(a));
 }
 
 namespace {

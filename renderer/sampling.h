@@ -58,10 +58,13 @@ inline Vec2 sample_uniform_triangle(Vec2 u) {
 }
 
 // Power heuristic with beta = 2 (Veach 1997, section 9.2), counts folded into the pdfs.
+// In ratio form, a^2 / (a^2 + b^2) = 1 / (1 + (b/a)^2): squaring large (grazing light) pdfs
+// would overflow to inf / inf = NaN, and squaring tiny ones would underflow to 0 / 0.
 inline float power_heuristic(float pdf_a, float pdf_b) {
   if (pdf_a == kInf) return 1;
-  float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
-  return a + b > 0 ? a / (a + b) : 0;
+  if (!(pdf_a > 0)) return 0;
+  float r = pdf_b / pdf_a;
+  return 1 / (1 + r * r);
 }
 
 // Piecewise-constant 1D distribution over n bins of [0, 1).
@@ -84,6 +87,11 @@ class Distribution1D {
   double total() const { return m_total; }
   // Discrete sample: returns the bin and its probability; u is remapped to [0,1) within the bin.
   size_t sample_discrete(float u, float* prob, float* u_remapped = nullptr) const {
+    if (m_func.empty()) {  // nothing to choose from: probability 0, callers skip
+      if (prob) *prob = 0;
+      if (u_remapped) *u_remapped = 0;
+      return 0;
+    }
     size_t lo = 0, hi = m_func.size();
     while (lo + 1 < hi) {  // last i with cdf[i] <= u
       size_t mid = (lo + hi) / 2;
@@ -94,7 +102,7 @@ class Distribution1D {
     if (u_remapped) *u_remapped = width > 0 ? clampf(float((u - m_cdf[lo]) / width), 0.0f, 0x1.fffffep-1f) : 0.0f;
     return lo;
   }
-  float discrete_pdf(size_t i) const { return float(m_cdf[i + 1] - m_cdf[i]); }
+  float discrete_pdf(size_t i) const { return i + 1 < m_cdf.size() ? float(m_cdf[i + 1] - m_cdf[i]) : 0.0f; }
 
  private:
   std::vector<float> m_func;
