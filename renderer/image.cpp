@@ -96,6 +96,22 @@ std::string encode_png8(const std::vector<uint8_t>& rgb, int width, int height) 
   return std::string(buffer.begin(), buffer.end());
 }
 
+std::string encode_exr(const ImageRGB& img, const Metadata& meta) {
+  std::vector<unsigned char> buffer;
+  OIIO::Filesystem::IOVecOutput vec(buffer);
+  auto out = OIIO::ImageOutput::create("image.exr");
+  if (!out) throw std::runtime_error("EXR encoder unavailable");
+  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
+  spec.attribute("compression", "zip");
+  for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
+  OIIO::Filesystem::IOProxy* proxy = &vec;
+  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  if (!out->supports("ioproxy")) throw std::runtime_error("this OpenImageIO cannot write EXR to memory");
+  if (!out->open("image.exr", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, img.pixels.data()) || !out->close())
+    throw std::runtime_error("EXR encoding failed: " + out->geterror());
+  return std::string(buffer.begin(), buffer.end());
+}
+
 ImageRGB read_image(const std::string& path) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw std::runtime_error(path + ": cannot read image: " + OIIO::geterror());

@@ -28,6 +28,8 @@ void write_image(const ImageRGB& img, const std::string& path, const Metadata& m
 void write_png8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path);
 // Encodes 8-bit RGB rows as PNG bytes in memory (for streaming tiles).
 std::string encode_png8(const std::vector<uint8_t>& rgb, int width, int height);
+// Encodes a float image as EXR bytes in memory (linear, with metadata).
+std::string encode_exr(const ImageRGB& img, const Metadata& meta = {});
 // Reads any image OpenImageIO can read as linear RGB float (top row first); throws on failure.
 ImageRGB read_image(const std::string& path);
 

@@ -297,6 +297,21 @@ double RenderSession::progress() const {
   return total > 0 ? std::min(1.0, double(m_budget_done.load()) / total) : 1.0;
 }
 
+void RenderSession::read_tile(const Tile& t, std::vector<Vec3>& out) const {
+  out.clear();
+  for (int y = t.y0; y < t.y1; ++y)
+    for (int x = t.x0; x < t.x1; ++x) {
+      size_t i = size_t(y) * m_w + x;
+      out.push_back(m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f));
+    }
+}
+
+float autofocus_distance(const RenderScene& scene, float sx, float sy) {
+  Ray r = scene.camera.pinhole_ray(sx, sy);
+  SurfaceHit hit;
+  return scene.accel->intersect(r, hit) ? hit.t : kInf;
+}
+
 ImageRGB RenderSession::image() const {
   ImageRGB img;
   img.width = m_w;

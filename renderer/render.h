@@ -62,6 +62,10 @@ struct RenderScene {
 // visible panels, emissive meshes as mesh lights), the environment map, the camera, the BVH.
 std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params);
 
+// Distance along the pinhole ray through sensor point (sx, sy) (y up) to the first surface, or
+// infinity: what autofocus sets the focal distance to, as in the course.
+float autofocus_distance(const RenderScene& scene, float sx, float sy);
+
 // One camera path's radiance (integrator.cpp). `rays` counts every ray cast.
 Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, class Pcg32& rng, uint64_t& rays);
 
@@ -97,6 +101,9 @@ class RenderSession {
   double error_estimate() const;
   SessionStats stats() const;
   const std::vector<Tile>& tiles() const { return m_tiles; }
+  // Mean radiance of a tile's pixels, row by row. Safe inside on_tile for that tile (its worker
+  // has finished it for this pass) and whenever no pass is running.
+  void read_tile(const Tile& t, std::vector<Vec3>& out) const;
 
  private:
   void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,

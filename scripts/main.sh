@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
-# The main job: installs dependencies, builds, and renders the bundled default scene.
+# The main job: installs dependencies, builds, and starts the render server with the bundled
+# scenes and the web page. Options are passed to render-server (e.g. --port 9000).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
-mkdir -p out
-./build/pathtracer -t "$(nproc)" -s 64 -l 4 -m 5 -r 480 360 -f out/cornell.png scenes/cornell.dae
-echo "Wrote out/cornell.png (and out/cornell_rate.png)"
+exec ./build/render-server --data "${PT_DATA_DIR:-data}" "$@"

@@ -1,0 +1,47 @@
+// A render job's specification: parsed and validated from the HTTP JSON body into RenderParams,
+// with every error naming its field.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "render.h"
+
+namespace srv {
+
+using json = nlohmann::json;
+
+// A request error: HTTP status, message and the offending field ("" when none).
+class ApiError : public std::runtime_error {
+ public:
+  ApiError(int status, std::string message, std::string field = "")
+      : std::runtime_error(std::move(message)), m_status(status), m_field(std::move(field)) {}
+  int status() const { return m_status; }
+  const std::string& field() const { return m_field; }
+
+ private:
+  int m_status;
+  std::string m_field;
+};
+
+struct JobSpec {
+  std::string scene;          // a scene file's name without ".dae"
+  pt::RenderParams params;    // threads is the server's, not the client's
+  double time_limit = 0;      // seconds; 0 = none
+  double target_error = 0;    // stop when the error estimate reaches this; 0 = none
+};
+
+struct SpecLimits {
+  int max_width = 4096, max_height = 4096, max_spp = 65536, max_depth = 10000, max_light_samples = 64;
+  double max_pixel_samples = 4294967296.0;  // width * height * spp
+};
+
+// Parses a JSON body (already parsed) into a spec with defaults; throws ApiError(400, ..., field).
+JobSpec parse_job_spec(const json& body, const SpecLimits& limits = {});
+json job_spec_to_json(const JobSpec& spec);
+// The defaults and limits, as the API documents them.
+json job_spec_defaults();
+bool valid_scene_name(const std::string& name);
+
+}  // namespace srv

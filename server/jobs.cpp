@@ -1,0 +1,500 @@
+// Job queue, render workers and persistence. Layout on disk: <data>/jobs/<id>/job.json (spec and
+// state), image.exr and image.png once done; every file is written to a temp name, then renamed.
+#include "jobs.h"
+
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "collada.h"
+#include "image.h"
+
+namespace srv {
+
+namespace {
+
+double now_unix() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string new_job_id() {
+  // Sortable by creation time, unique within a process and across restarts.
+  static std::mutex mutex;
+  static std::mt19937_64 rng(std::random_device{}());
+  std::lock_guard<std::mutex> lock(mutex);
+  auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%011llx%05llx", (unsigned long long)ms, (unsigned long long)(rng() & 0xfffff));
+  return buf;
+}
+
+bool valid_job_id(const std::string& id) {
+  if (id.empty() || id.size() > 40) return false;
+  for (char c : id)
+    if (!std::isxdigit((unsigned char)c)) return false;
+  return true;
+}
+
+void make_dirs(const std::string& path) {
+  std::string cur;
+  std::stringstream ss(path);
+  std::string part;
+  if (!path.empty() && path[0] == '/') cur = "/";
+  while (std::getline(ss, part, '/')) {
+    if (part.empty()) continue;
+    cur += part + "/";
+    mkdir(cur.c_str(), 0755);
+  }
+}
+
+// Writes a whole file under a temp name and renames it into place: readers never see a partial file.
+void write_file_atomic(const std::string& path, const std::string& data) {
+  std::string tmp = path + ".tmp" + std::to_string(getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out.write(data.data(), std::streamsize(data.size()));
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw std::runtime_error("cannot write " + path);
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot move " + path + " into place");
+  }
+}
+
+bool read_file(const std::string& path, std::string& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  out = ss.str();
+  return true;
+}
+
+}  // namespace
+
+const char* job_state_name(JobState s) {
+  switch (s) {
+    case JobState::queued: return "queued";
+    case JobState::running: return "running";
+    case JobState::done: return "done";
+    case JobState::failed: return "failed";
+    case JobState::cancelled: return "cancelled";
+  }
+  return "?";
+}
+
+bool parse_job_state(const std::string& s, JobState* out) {
+  for (JobState st : {JobState::queued, JobState::running, JobState::done, JobState::failed, JobState::cancelled})
+    if (s == job_state_name(st)) {
+      *out = st;
+      return true;
+    }
+  return false;
+}
+
+JobManager::JobManager(ManagerConfig config) : m_config(std::move(config)), m_scenes(m_config.scene_dirs) {}
+
+JobManager::~JobManager() { stop(); }
+
+std::string JobManager::job_dir(const std::string& id) const { return m_config.data_dir + "/jobs/" + id; }
+
+void JobManager::start() {
+  make_dirs(m_config.data_dir + "/jobs");
+  struct stat st;
+  if (stat((m_config.data_dir + "/jobs").c_str(), &st) != 0 || access((m_config.data_dir + "/jobs").c_str(), W_OK) != 0)
+    throw std::runtime_error("data directory '" + m_config.data_dir + "' is not writable");
+  load_persisted();
+  for (int i = 0; i < std::max(1, m_config.concurrency); ++i) m_workers.emplace_back([this] { worker_loop(); });
+}
+
+void JobManager::stop() {
+  if (m_stopping.exchange(true)) {
+    for (auto& w : m_workers)
+      if (w.joinable()) w.join();
+    return;
+  }
+  m_queue_cv.notify_all();
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    for (auto& kv : m_jobs) kv.second->changed.notify_all();
+  }
+  for (auto& w : m_workers)
+    if (w.joinable()) w.join();
+}
+
+JobSpec JobManager::check(const json& body) const {
+  JobSpec spec = parse_job_spec(body, m_config.limits);
+  if (m_scenes.resolve(spec.scene).empty())
+    throw ApiError(404, "unknown scene '" + spec.scene + "'", "scene");
+  return spec;
+}
+
+std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const std::string& key) {
+  JobSpec spec = check(body);
+  std::lock_guard<std::mutex> lock(m_mutex);
+  if (m_stopping) throw ApiError(503, "the server is shutting down");
+  if (!key.empty()) {
+    auto it = m_idempotency.find(key);
+    if (it != m_idempotency.end()) {
+      auto job = m_jobs.at(it->second);
+      if (job_spec_to_json(job->spec) != job_spec_to_json(spec))
+        throw ApiError(409, "Idempotency-Key was used for a different job", "Idempotency-Key");
+      return {job, false};
+    }
+  }
+  if (m_queue.size() >= m_config.max_queue)
+    throw ApiError(429, "the queue is full (" + std::to_string(m_config.max_queue) + " jobs waiting); retry later");
+  auto job = std::make_shared<Job>();
+  job->id = new_job_id();
+  job->spec = spec;
+  job->idempotency_key = key;
+  job->created_at = now_unix();
+  {
+    std::lock_guard<std::mutex> jl(job->mutex);
+    make_dirs(job_dir(job->id));
+    persist(*job);
+  }
+  m_jobs[job->id] = job;
+  if (!key.empty()) m_idempotency[key] = job->id;
+  m_queue.push_back(job);
+  m_queue_cv.notify_one();
+  return {job, true};
+}
+
+std::shared_ptr<Job> JobManager::get(const std::string& id) const {
+  if (!valid_job_id(id)) return nullptr;
+  std::lock_guard<std::mutex> lock(m_mutex);
+  auto it = m_jobs.find(id);
+  return it == m_jobs.end() ? nullptr : it->second;
+}
+
+std::vector<std::shared_ptr<Job>> JobManager::list() const {
+  std::lock_guard<std::mutex> lock(m_mutex);
+  std::vector<std::shared_ptr<Job>> out;
+  for (auto& kv : m_jobs) out.push_back(kv.second);
+  return out;
+}
+
+void JobManager::cancel(const std::string& id) {
+  auto job = get(id);
+  if (!job) throw ApiError(404, "no job '" + id + "'");
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    auto it = std::find(m_queue.begin(), m_queue.end(), job);
+    if (it != m_queue.end()) {
+      m_queue.erase(it);
+      std::lock_guard<std::mutex> jl(job->mutex);
+      job->state = JobState::cancelled;
+      job->finished_at = now_unix();
+      ++job->version;
+      persist(*job);
+      job->changed.notify_all();
+      return;
+    }
+  }
+  std::lock_guard<std::mutex> jl(job->mutex);
+  if (is_final(job->state))
+    throw ApiError(409, std::string("job is already ") + job_state_name(job->state));
+  job->cancel = true;  // the worker stops within a few samples and marks it cancelled
+}
+
+json JobManager::status_json(const Job& j, bool with_history) const {
+  json s{{"id", j.id},
+         {"url", "/api/jobs/" + j.id},
+         {"state", job_state_name(j.state)},
+         {"spec", job_spec_to_json(j.spec)},
+         {"progress", j.progress},
+         {"samples", j.samples},
+         {"spp_done", j.width > 0 ? double(j.samples) / (double(j.width) * j.height) : 0.0},
+         {"elapsed", j.elapsed},
+         {"eta", j.eta >= 0 ? json(j.eta) : json(nullptr)},
+         {"error_estimate", j.error_estimate >= 0 ? json(j.error_estimate) : json(nullptr)},
+         {"nonfinite_samples", j.nonfinite},
+         {"rays", j.rays},
+         {"created_at", j.created_at},
+         {"started_at", j.started_at > 0 ? json(j.started_at) : json(nullptr)},
+         {"finished_at", j.finished_at > 0 ? json(j.finished_at) : json(nullptr)},
+         {"width", j.spec.params.cell_w > 0 ? j.spec.params.cell_w : j.spec.params.width},
+         {"height", j.spec.params.cell_h > 0 ? j.spec.params.cell_h : j.spec.params.height},
+         {"tile_size", j.spec.params.tile_size},
+         {"features", j.features},
+         {"images", {{"png", "/api/jobs/" + j.id + "/image.png"}, {"exr", "/api/jobs/" + j.id + "/image.exr"}}},
+         {"events", "/api/jobs/" + j.id + "/events"}};
+  if (!j.message.empty()) s["message"] = j.message;
+  if (with_history) {
+    json h = json::array();
+    for (const ErrorPoint& p : j.history) h.push_back({{"seconds", p.seconds}, {"spp", p.spp}, {"error", p.error}});
+    s["error_history"] = h;
+  }
+  return s;
+}
+
+double JobManager::focus_distance(const Job& job, double x, double y) {
+  pt::RenderParams p = job.spec.params;
+  if (!(x >= 0 && y >= 0 && x <= p.width && y <= p.height))
+    throw ApiError(400, "x and y must lie inside the " + std::to_string(p.width) + "x" + std::to_string(p.height) + " image", "x");
+  auto desc = m_scenes.load(job.spec.scene);
+  p.env_map.clear();
+  auto scene = pt::make_render_scene(*desc, p);
+  return pt::autofocus_distance(*scene, float(x / p.width), float(1 - y / p.height));
+}
+
+void JobManager::persist(Job& j) {
+  json doc = status_json(j);
+  doc["idempotency_key"] = j.idempotency_key;
+  try {
+    write_file_atomic(job_dir(j.id) + "/job.json", doc.dump(1));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "render-server: job %s: %s\n", j.id.c_str(), e.what());
+  }
+}
+
+void JobManager::load_persisted() {
+  std::string root = m_config.data_dir + "/jobs";
+  DIR* d = opendir(root.c_str());
+  if (!d) return;
+  std::vector<std::string> ids;
+  while (dirent* e = readdir(d))
+    if (valid_job_id(e->d_name)) ids.push_back(e->d_name);
+  closedir(d);
+  std::sort(ids.begin(), ids.end());  // ids sort by creation time: the queue keeps its order
+  for (const std::string& id : ids) {
+    std::string text;
+    if (!read_file(root + "/" + id + "/job.json", text)) continue;
+    try {
+      json doc = json::parse(text);
+      auto job = std::make_shared<Job>();
+      job->id = id;
+      job->spec = parse_job_spec(doc.at("spec"), m_config.limits);
+      job->idempotency_key = doc.value("idempotency_key", "");
+      job->created_at = doc.value("created_at", 0.0);
+      JobState st = JobState::queued;
+      parse_job_state(doc.value("state", "queued"), &st);
+      struct stat sb;
+      bool image_ok = stat((root + "/" + id + "/image.png").c_str(), &sb) == 0 &&
+                      stat((root + "/" + id + "/image.exr").c_str(), &sb) == 0;
+      if (st == JobState::running || (st == JobState::done && !image_ok)) st = JobState::queued;  // interrupted: run again
+      job->state = st;
+      if (st != JobState::queued) {
+        job->message = doc.value("message", "");
+        job->progress = doc.value("progress", 0.0);
+        job->samples = doc.value("samples", uint64_t(0));
+        job->elapsed = doc.value("elapsed", 0.0);
+        job->nonfinite = doc.value("nonfinite_samples", uint64_t(0));
+        job->rays = doc.value("rays", uint64_t(0));
+        if (doc.contains("error_estimate") && doc["error_estimate"].is_number()) job->error_estimate = doc["error_estimate"];
+        if (doc.contains("started_at") && doc["started_at"].is_number()) job->started_at = doc["started_at"];
+        if (doc.contains("finished_at") && doc["finished_at"].is_number()) job->finished_at = doc["finished_at"];
+        for (const json& p : doc.value("error_history", json::array()))
+          job->history.push_back({p.value("seconds", 0.0), p.value("spp", 0.0), p.value("error", 0.0)});
+        if (doc.contains("features")) job->features = doc["features"].get<std::vector<std::string>>();
+        job->width = job->spec.params.width;
+        job->height = job->spec.params.height;
+      }
+      m_jobs[id] = job;
+      if (!job->idempotency_key.empty()) m_idempotency[job->idempotency_key] = id;
+      if (st == JobState::queued) {
+        std::lock_guard<std::mutex> jl(job->mutex);
+        persist(*job);
+        m_queue.push_back(job);
+      }
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "render-server: skipping %s/%s/job.json: %s\n", root.c_str(), id.c_str(), e.what());
+    }
+  }
+}
+
+void JobManager::worker_loop() {
+  for (;;) {
+    std::shared_ptr<Job> job;
+    {
+      std::unique_lock<std::mutex> lock(m_mutex);
+      m_queue_cv.wait(lock, [&] { return m_stopping || !m_queue.empty(); });
+      if (m_stopping) return;
+      job = m_queue.front();
+      m_queue.pop_front();
+    }
+    run_job(job);
+  }
+}
+
+void JobManager::run_job(const std::shared_ptr<Job>& job) {
+  using clock = std::chrono::steady_clock;
+  auto notify = [&] { job->changed.notify_all(); };
+  try {
+    auto desc = m_scenes.load(job->spec.scene);
+    pt::RenderParams p = job->spec.params;
+    p.threads = std::max(1, m_config.threads);
+    auto scene = pt::make_render_scene(*desc, p);
+    pt::RenderSession session(*scene, p);
+    {
+      std::lock_guard<std::mutex> lock(job->mutex);
+      if (job->cancel) throw ApiError(409, "cancelled");
+      job->state = JobState::running;
+      job->started_at = now_unix();
+      job->width = session.width();
+      job->height = session.height();
+      job->tile_size = p.tile_size;
+      job->tiles_x = (job->width + p.tile_size - 1) / p.tile_size;
+      job->tiles_y = (job->height + p.tile_size - 1) / p.tile_size;
+      size_t n = size_t(job->width) * job->height;
+      job->linear.assign(n * 3, 0.0f);
+      job->display.assign(n * 3, 0);
+      job->tile_version.assign(size_t(job->tiles_x) * job->tiles_y, 0);
+      job->tile_png.assign(job->tile_version.size(), std::string());
+      job->tile_png_version.assign(job->tile_version.size(), 0);
+      job->samples = 0;
+      job->history.clear();
+      job->has_image = false;
+      const pt::SceneFeatures& f = scene->features;
+      job->features = f.materials;
+      for (const std::string& l : f.lights) job->features.push_back(l + " light");
+      if (f.spheres) job->features.push_back("spheres");
+      if (f.environment) job->features.push_back("environment map");
+      if (f.thin_lens) job->features.push_back("thin lens");
+      if (f.adaptive) job->features.push_back("adaptive sampling");
+      ++job->version;
+      persist(*job);
+    }
+    notify();
+
+    // One flag stops the session: user cancel, shutdown, or the time limit (polled every 20 ms).
+    std::atomic<bool> stop{false}, done{false};
+    auto start = clock::now();
+    std::thread poller([&] {
+      while (!done) {
+        bool expired = job->spec.time_limit > 0 &&
+                       std::chrono::duration<double>(clock::now() - start).count() >= job->spec.time_limit;
+        if (job->cancel || m_stopping || expired) {
+          stop = true;
+          return;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    });
+    struct Joiner {
+      std::atomic<bool>& done;
+      std::thread& t;
+      ~Joiner() {
+        done = true;
+        if (t.joinable()) t.join();
+      }
+    } joiner{done, poller};
+
+    auto on_tile = [&](const pt::Tile& t) {
+      thread_local std::vector<pt::Vec3> buf;
+      session.read_tile(t, buf);
+      {
+        std::lock_guard<std::mutex> lock(job->mutex);
+        size_t k = 0;
+        for (int y = t.y0; y < t.y1; ++y)
+          for (int x = t.x0; x < t.x1; ++x, ++k) {
+            size_t i = (size_t(y) * job->width + x) * 3;
+            for (int c = 0; c < 3; ++c) {
+              job->linear[i + c] = buf[k][c];
+              job->display[i + c] = pt::tonemap_course(buf[k][c]);
+            }
+          }
+        job->tile_version[size_t(t.y0 / job->tile_size) * job->tiles_x + t.x0 / job->tile_size] = ++job->version;
+        job->has_image = true;
+      }
+      notify();
+    };
+
+    int target = 1;
+    auto last_persist = clock::now();
+    for (;;) {
+      bool completed = session.render_pass(target, &stop, on_tile);
+      pt::SessionStats st = session.stats();
+      double err = session.error_estimate();
+      {
+        std::lock_guard<std::mutex> lock(job->mutex);
+        job->samples = st.samples;
+        job->rays = st.rays;
+        job->nonfinite = st.nonfinite;
+        job->elapsed = std::chrono::duration<double>(clock::now() - start).count();
+        job->progress = session.progress();
+        if (std::isfinite(err)) {
+          job->error_estimate = err;
+          job->history.push_back({job->elapsed, double(st.samples) / (double(job->width) * job->height), err});
+        }
+        // ETA from the sample budget, or (when sooner) from error ~ 1/spp towards the target.
+        double eta = job->progress > 0 ? job->elapsed * (1 - job->progress) / job->progress : -1;
+        if (job->spec.target_error > 0 && std::isfinite(err) && err > 0)
+          eta = std::min(eta < 0 ? 1e30 : eta, job->elapsed * std::max(0.0, err / job->spec.target_error - 1));
+        if (job->spec.time_limit > 0) eta = std::min(eta < 0 ? 1e30 : eta, std::max(0.0, job->spec.time_limit - job->elapsed));
+        job->eta = eta;
+        ++job->version;
+        if (clock::now() - last_persist > std::chrono::seconds(1)) {
+          persist(*job);
+          last_persist = clock::now();
+        }
+      }
+      notify();
+      if (!completed) break;
+      if (session.finished() || target >= p.spp) break;
+      if (job->spec.target_error > 0 && err <= job->spec.target_error) break;
+      target = std::min(p.spp, target * 2);
+    }
+
+    if (m_stopping && !job->cancel) {  // shutdown: run it again after a restart
+      std::lock_guard<std::mutex> lock(job->mutex);
+      job->state = JobState::queued;
+      job->progress = 0;
+      ++job->version;
+      persist(*job);
+      notify();
+      return;
+    }
+    if (job->cancel) {
+      std::lock_guard<std::mutex> lock(job->mutex);
+      job->state = JobState::cancelled;
+      job->finished_at = now_unix();
+      ++job->version;
+      persist(*job);
+      notify();
+      return;
+    }
+    // Finished (sample budget, error target or time limit): images first, then the state.
+    pt::ImageRGB img = session.image();
+    pt::Metadata meta{{"pathtracer:scene", job->spec.scene},
+                      {"pathtracer:job", job->id},
+                      {"pathtracer:spec", job_spec_to_json(job->spec).dump()},
+                      {"pathtracer:achieved_spp", std::to_string(double(session.stats().samples) / (double(img.width) * img.height))},
+                      {"pathtracer:wall_seconds", std::to_string(session.stats().seconds)},
+                      {"pathtracer:error_estimate", std::to_string(session.error_estimate())},
+                      {"pathtracer:seed", std::to_string(p.seed)},
+                      {"pathtracer:nonfinite_samples", std::to_string(session.stats().nonfinite)}};
+    pt::write_image(img, job_dir(job->id) + "/image.exr", meta);
+    pt::write_image(img, job_dir(job->id) + "/image.png");
+    std::lock_guard<std::mutex> lock(job->mutex);
+    job->state = JobState::done;
+    job->progress = 1;
+    job->eta = 0;
+    job->finished_at = now_unix();
+    ++job->version;
+    persist(*job);
+    notify();
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(job->mutex);
+    job->state = job->cancel ? JobState::cancelled : JobState::failed;
+    if (!job->cancel) job->message = e.what();
+    job->finished_at = now_unix();
+    ++job->version;
+    persist(*job);
+    notify();
+  }
+}
+
+}  // namespace srv

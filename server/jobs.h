@@ -1,0 +1,112 @@
+// The job queue: bounded, persistent (one folder per job in the data directory), rendering one
+// job at a time (configurable) through the renderer's progressive session.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "job_spec.h"
+#include "scene_library.h"
+
+namespace srv {
+
+enum class JobState { queued, running, done, failed, cancelled };
+const char* job_state_name(JobState s);
+bool parse_job_state(const std::string& s, JobState* out);
+inline bool is_final(JobState s) { return s == JobState::done || s == JobState::failed || s == JobState::cancelled; }
+
+struct ErrorPoint {
+  double seconds, spp, error;
+};
+
+// One job. Fields below `mutex` are guarded by it; `changed` is signalled on every update.
+struct Job {
+  std::string id;
+  JobSpec spec;
+  std::string idempotency_key;
+  std::atomic<bool> cancel{false};
+
+  mutable std::mutex mutex;
+  std::condition_variable changed;
+  uint64_t version = 1;  // bumps on every change; also the SSE event id
+  JobState state = JobState::queued;
+  std::string message;   // why it failed
+  double created_at = 0, started_at = 0, finished_at = 0;  // unix seconds
+  double progress = 0, elapsed = 0, eta = -1, error_estimate = -1;
+  uint64_t samples = 0, rays = 0, nonfinite = 0;
+  std::vector<ErrorPoint> history;
+  std::vector<std::string> features;
+
+  // The live image: linear RGB, the 8-bit display version, and per-tile versions.
+  int width = 0, height = 0, tile_size = 32, tiles_x = 0, tiles_y = 0;
+  std::vector<float> linear;
+  std::vector<uint8_t> display;
+  std::vector<uint64_t> tile_version;
+  bool has_image = false;
+  // Cached PNG encodings of tiles, so many watchers encode each tile version once.
+  std::vector<std::string> tile_png;
+  std::vector<uint64_t> tile_png_version;
+};
+
+struct ManagerConfig {
+  std::string data_dir = "data";
+  std::vector<std::string> scene_dirs;
+  int threads = 1;          // render threads per job
+  int concurrency = 1;      // jobs rendering at once
+  size_t max_queue = 32;    // queued jobs; more is refused
+  SpecLimits limits;
+};
+
+class JobManager {
+ public:
+  explicit JobManager(ManagerConfig config);
+  ~JobManager();
+
+  // Reloads persisted jobs (re-queueing interrupted ones) and starts the workers.
+  void start();
+  // Stops the workers; a running job is put back in the queue on disk so a restart resumes it.
+  void stop();
+
+  // Validates and queues; returns the job and whether it was created (false: same idempotency key).
+  std::pair<std::shared_ptr<Job>, bool> submit(const json& body, const std::string& idempotency_key);
+  // Validates only (scene existence included); returns the normalised spec.
+  JobSpec check(const json& body) const;
+  std::shared_ptr<Job> get(const std::string& id) const;
+  std::vector<std::shared_ptr<Job>> list() const;
+  // Cancels a queued or running job; throws ApiError 409 for a finished one.
+  void cancel(const std::string& id);
+
+  json status_json(const Job& job, bool with_history = true) const;  // job.mutex must be held
+  // Distance from the job's camera through pixel (x, y) (top-left origin) to the first surface;
+  // infinity when the ray escapes. What the page's click-to-focus sets the focal distance to.
+  double focus_distance(const Job& job, double x, double y);
+  const ManagerConfig& config() const { return m_config; }
+  SceneLibrary& scenes() { return m_scenes; }
+  std::string job_dir(const std::string& id) const;
+  bool stopping() const { return m_stopping.load(); }
+
+ private:
+  void worker_loop();
+  void run_job(const std::shared_ptr<Job>& job);
+  void persist(Job& job);  // job.mutex must be held
+  void load_persisted();
+
+  ManagerConfig m_config;
+  SceneLibrary m_scenes;
+  mutable std::mutex m_mutex;
+  std::condition_variable m_queue_cv;
+  std::map<std::string, std::shared_ptr<Job>> m_jobs;
+  std::map<std::string, std::string> m_idempotency;  // key -> job id
+  std::deque<std::shared_ptr<Job>> m_queue;
+  std::vector<std::thread> m_workers;
+  std::atomic<bool> m_stopping{false};
+};
+
+}  // namespace srv

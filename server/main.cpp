@@ -1,0 +1,119 @@
+// render-server: the job queue behind an HTTP API, serving web/ at /.
+#include <httplib.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <cstring>
+#include <thread>
+
+#include "jobs.h"
+#include "routes.h"
+
+extern const char* kOpenApiJson;  // generated from server/openapi.json at build time
+
+namespace {
+
+const char* kUsage =
+    "Usage: render-server [options]\n"
+    "Renders queued path-tracing jobs and serves the API (/api) and the web page (/).\n"
+    "  --host ADDR       address to bind (default 127.0.0.1; 0.0.0.0 opens it to the network)\n"
+    "  --port N          port (default 8080; 0 picks a free one and prints it)\n"
+    "  --data DIR        jobs and images (default ./data)\n"
+    "  --scenes DIR      a folder of .dae scenes; repeatable (default: the bundled scenes/)\n"
+    "  --web DIR         the page to serve at / (default: the bundled web/)\n"
+    "  --threads N       render threads per job (default: all cores)\n"
+    "  --concurrency N   jobs rendering at once (default 1)\n"
+    "  --max-queue N     queued jobs before new ones are refused with 429 (default 32)\n"
+    "  -h, --help        this text\n";
+
+bool parse_int(const char* s, long lo, long hi, long* out) {
+  char* end;
+  long v = std::strtol(s, &end, 10);
+  if (*s == '\0' || *end != '\0' || v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string host = "127.0.0.1", web = PT_SOURCE_DIR "/web";
+  long port = 8080, n;
+  srv::ManagerConfig cfg;
+  cfg.threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  bool scenes_given = false;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "render-server: %s needs a value\n\n%s", a.c_str(), kUsage);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    auto bad = [&](const char* v) {
+      std::fprintf(stderr, "render-server: bad value '%s' for %s\n\n%s", v, a.c_str(), kUsage);
+      std::exit(2);
+    };
+    if (a == "--host") host = value();
+    else if (a == "--port") { const char* v = value(); if (!parse_int(v, 0, 65535, &port)) bad(v); }
+    else if (a == "--data") cfg.data_dir = value();
+    else if (a == "--scenes") { cfg.scene_dirs.push_back(value()); scenes_given = true; }
+    else if (a == "--web") web = value();
+    else if (a == "--threads") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.threads = int(n); }
+    else if (a == "--concurrency") { const char* v = value(); if (!parse_int(v, 1, 64, &n)) bad(v); cfg.concurrency = int(n); }
+    else if (a == "--max-queue") { const char* v = value(); if (!parse_int(v, 0, 100000, &n)) bad(v); cfg.max_queue = size_t(n); }
+    else if (a == "-h" || a == "--help") { std::printf("%s", kUsage); return 0; }
+    else { std::fprintf(stderr, "render-server: unknown option '%s'\n\n%s", a.c_str(), kUsage); return 2; }
+  }
+  if (!scenes_given) cfg.scene_dirs = {PT_SOURCE_DIR "/scenes", PT_BINARY_DIR "/scenes"};
+
+  // SIGINT/SIGTERM are taken by one thread with sigwait, so a signal never interrupts a render.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  srv::JobManager jobs(cfg);
+  try {
+    jobs.start();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "render-server: %s\n", e.what());
+    return 1;
+  }
+
+  httplib::Server svr;
+  svr.new_task_queue = [] { return new httplib::ThreadPool(64); };
+  svr.set_payload_max_length(64 * 1024);
+  svr.set_read_timeout(10, 0);
+  svr.set_write_timeout(10, 0);
+  svr.set_keep_alive_max_count(100);
+  srv::install_routes(svr, jobs, kOpenApiJson);
+  if (!svr.set_mount_point("/", web)) std::fprintf(stderr, "render-server: warning: no web page at %s\n", web.c_str());
+
+  int bound = port == 0 ? svr.bind_to_any_port(host) : (svr.bind_to_port(host, int(port)) ? int(port) : -1);
+  if (bound < 0) {
+    std::fprintf(stderr, "render-server: cannot listen on %s:%ld\n", host.c_str(), port);
+    jobs.stop();
+    return 1;
+  }
+  std::printf("render-server: listening on http://%s:%d/\n", host.c_str(), bound);
+  std::fflush(stdout);
+
+  std::thread signal_thread([&] {
+    int sig = 0;
+    sigwait(&signals, &sig);
+    std::fprintf(stderr, "render-server: %s, stopping\n", sig == SIGINT ? "SIGINT" : "SIGTERM");
+    jobs.stop();  // wakes event streams and puts a running job back in the queue
+    svr.stop();
+  });
+  svr.listen_after_bind();
+  jobs.stop();
+  if (signal_thread.joinable()) {
+    pthread_kill(signal_thread.native_handle(), SIGTERM);
+    signal_thread.join();
+  }
+  return 0;
+}

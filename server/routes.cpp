@@ -1,0 +1,341 @@
+// HTTP routes: thin handlers that validate, enqueue or copy a status snapshot; the job event
+// stream (Server-Sent Events) with per-client tile bookkeeping so slow clients skip ahead.
+#include "routes.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "image.h"
+
+namespace srv {
+
+namespace {
+
+void send_json(httplib::Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(), "application/json");
+}
+
+void send_error(httplib::Response& res, int status, const std::string& message, const std::string& field = "") {
+  json err{{"status", status}, {"message", message}};
+  if (!field.empty()) err["field"] = field;
+  send_json(res, status, json{{"error", err}});
+}
+
+std::string base64(const std::string& in) {
+  static const char* tbl = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    uint32_t v = (uint8_t(in[i]) << 16) | (uint8_t(in[i + 1]) << 8) | uint8_t(in[i + 2]);
+    out += tbl[v >> 18];
+    out += tbl[(v >> 12) & 63];
+    out += tbl[(v >> 6) & 63];
+    out += tbl[v & 63];
+  }
+  if (i + 1 == in.size()) {
+    uint32_t v = uint8_t(in[i]) << 16;
+    out += tbl[v >> 18];
+    out += tbl[(v >> 12) & 63];
+    out += "==";
+  } else if (i + 2 == in.size()) {
+    uint32_t v = (uint8_t(in[i]) << 16) | (uint8_t(in[i + 1]) << 8);
+    out += tbl[v >> 18];
+    out += tbl[(v >> 12) & 63];
+    out += tbl[(v >> 6) & 63];
+    out += '=';
+  }
+  return out;
+}
+
+bool read_file(const std::string& path, std::string& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  out = ss.str();
+  return true;
+}
+
+json parse_body(const httplib::Request& req) {
+  const std::string& ct = req.get_header_value("Content-Type");
+  if (!ct.empty() && ct.find("application/json") == std::string::npos)
+    throw ApiError(415, "Content-Type must be application/json");
+  try {
+    return json::parse(req.body);
+  } catch (const json::parse_error& e) {
+    throw ApiError(400, std::string("malformed JSON: ") + e.what());
+  }
+}
+
+// Runs a handler body, turning ApiError into its JSON error and anything else into a 500.
+template <typename F>
+void guarded(httplib::Response& res, F&& f) {
+  try {
+    f();
+  } catch (const ApiError& e) {
+    send_error(res, e.status(), e.what(), e.field());
+    if (e.status() == 429 || e.status() == 503) res.set_header("Retry-After", "5");
+  }
+}
+
+// The PNG of one tile at its current version, encoded once and shared by every watcher.
+// Returns false when the job has no such tile yet.
+bool tile_png(Job& job, size_t idx, std::string& png, int& x, int& y, int& w, int& h, uint64_t& version) {
+  std::vector<uint8_t> rgb;
+  {
+    std::lock_guard<std::mutex> lock(job.mutex);
+    if (idx >= job.tile_version.size() || job.tile_version[idx] == 0) return false;
+    version = job.tile_version[idx];
+    x = int(idx % job.tiles_x) * job.tile_size;
+    y = int(idx / job.tiles_x) * job.tile_size;
+    w = std::min(job.tile_size, job.width - x);
+    h = std::min(job.tile_size, job.height - y);
+    if (job.tile_png_version[idx] == version) {
+      png = job.tile_png[idx];
+      return true;
+    }
+    rgb.resize(size_t(w) * h * 3);
+    for (int r = 0; r < h; ++r)
+      std::memcpy(&rgb[size_t(r) * w * 3], &job.display[(size_t(y + r) * job.width + x) * 3], size_t(w) * 3);
+  }
+  png = pt::encode_png8(rgb, w, h);  // outside the lock: rendering never waits for encoding
+  std::lock_guard<std::mutex> lock(job.mutex);
+  if (job.tile_png_version[idx] < version) {
+    job.tile_png[idx] = png;
+    job.tile_png_version[idx] = version;
+  }
+  return true;
+}
+
+std::string sse(const std::string& event, const json& data, uint64_t id) {
+  return "id: " + std::to_string(id) + "\nevent: " + event + "\ndata: " + data.dump() + "\n\n";
+}
+
+// One watcher's event stream: the whole current image first, then status and changed tiles as
+// the job updates, newest state only (a slow client skips intermediate versions), until the job
+// ends. Returns when the job ends, the client goes away, or the server stops.
+void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::DataSink& sink) {
+  std::vector<uint64_t> sent;
+  uint64_t seen = 0;
+  bool first = true;
+  auto write = [&](const std::string& s) { return sink.write(s.data(), s.size()); };
+  if (!write("retry: 2000\n\n")) return;
+  for (;;) {
+    json status;
+    uint64_t version;
+    bool final_state, has_image;
+    std::vector<uint8_t> display;
+    int width = 0, height = 0;
+    {
+      std::unique_lock<std::mutex> lock(job->mutex);
+      bool changed = job->changed.wait_for(lock, std::chrono::seconds(15),
+                                           [&] { return job->version != seen || jobs.stopping(); });
+      if (jobs.stopping()) return;
+      if (!changed) {
+        lock.unlock();
+        if (!write(": keep-alive\n\n")) return;
+        continue;
+      }
+      version = job->version;
+      status = jobs.status_json(*job, false);
+      if (!job->history.empty()) {
+        const ErrorPoint& p = job->history.back();
+        status["error_point"] = {{"seconds", p.seconds}, {"spp", p.spp}, {"error", p.error}};
+      }
+      final_state = is_final(job->state);
+      has_image = job->has_image;
+      if (sent.size() != job->tile_version.size()) sent.assign(job->tile_version.size(), 0);
+      if (first && has_image) {
+        display = job->display;
+        width = job->width;
+        height = job->height;
+      }
+    }
+    if (first) {
+      // A late or reconnecting client starts from the current picture.
+      if (!display.empty()) {
+        if (!write(sse("image", {{"width", width}, {"height", height}, {"png", base64(pt::encode_png8(display, width, height))}}, version)))
+          return;
+        std::lock_guard<std::mutex> lock(job->mutex);
+        for (size_t i = 0; i < sent.size() && i < job->tile_version.size(); ++i) sent[i] = std::min(job->tile_version[i], version);
+      }
+      first = false;
+    }
+    if (!write(sse("status", status, version))) return;
+    for (size_t i = 0; i < sent.size(); ++i) {
+      uint64_t tv;
+      {
+        std::lock_guard<std::mutex> lock(job->mutex);
+        tv = i < job->tile_version.size() ? job->tile_version[i] : 0;
+      }
+      if (tv <= sent[i]) continue;
+      std::string png;
+      int x, y, w, h;
+      uint64_t v;
+      if (!tile_png(*job, i, png, x, y, w, h, v)) continue;
+      if (!write(sse("tile", {{"x", x}, {"y", y}, {"w", w}, {"h", h}, {"png", base64(png)}}, v))) return;
+      sent[i] = v;
+    }
+    seen = version;
+    if (final_state) {
+      write(sse("end", {{"state", status["state"]}}, version));
+      return;
+    }
+  }
+}
+
+}  // namespace
+
+void install_routes(httplib::Server& svr, JobManager& jobs, const std::string& openapi) {
+  svr.Get("/api/health", [&](const httplib::Request&, httplib::Response& res) {
+    size_t queued = 0, running = 0;
+    for (auto& j : jobs.list()) {
+      std::lock_guard<std::mutex> lock(j->mutex);
+      queued += j->state == JobState::queued;
+      running += j->state == JobState::running;
+    }
+    send_json(res, 200, {{"status", "ok"}, {"queued", queued}, {"running", running}});
+  });
+
+  svr.Get("/api/openapi.json", [openapi](const httplib::Request&, httplib::Response& res) {
+    res.set_content(openapi, "application/json");
+  });
+
+  svr.Get("/api/scenes", [&](const httplib::Request&, httplib::Response& res) {
+    send_json(res, 200, {{"scenes", jobs.scenes().list()}, {"defaults", job_spec_defaults()}});
+  });
+
+  svr.Post("/api/jobs/check", [&](const httplib::Request& req, httplib::Response& res) {
+    guarded(res, [&] {
+      JobSpec spec = jobs.check(parse_body(req));
+      send_json(res, 200, {{"valid", true}, {"spec", job_spec_to_json(spec)}});
+    });
+  });
+
+  svr.Post("/api/jobs", [&](const httplib::Request& req, httplib::Response& res) {
+    guarded(res, [&] {
+      std::string key = req.get_header_value("Idempotency-Key");
+      if (key.size() > 200) throw ApiError(400, "Idempotency-Key is longer than 200 characters", "Idempotency-Key");
+      auto [job, created] = jobs.submit(parse_body(req), key);
+      std::lock_guard<std::mutex> lock(job->mutex);
+      res.set_header("Location", "/api/jobs/" + job->id);
+      send_json(res, created ? 201 : 200, jobs.status_json(*job));
+    });
+  });
+
+  svr.Get("/api/jobs", [&](const httplib::Request&, httplib::Response& res) {
+    json list = json::array();
+    for (auto& j : jobs.list()) {
+      std::lock_guard<std::mutex> lock(j->mutex);
+      list.push_back(jobs.status_json(*j, false));
+    }
+    send_json(res, 200, {{"jobs", list}});
+  });
+
+  svr.Get(R"(/api/jobs/([^/]+))", [&](const httplib::Request& req, httplib::Response& res) {
+    auto job = jobs.get(req.matches[1]);
+    if (!job) return send_error(res, 404, "no job '" + std::string(req.matches[1]) + "'");
+    std::lock_guard<std::mutex> lock(job->mutex);
+    send_json(res, 200, jobs.status_json(*job));
+  });
+
+  svr.Delete(R"(/api/jobs/([^/]+))", [&](const httplib::Request& req, httplib::Response& res) {
+    guarded(res, [&] {
+      jobs.cancel(req.matches[1]);
+      auto job = jobs.get(req.matches[1]);
+      std::lock_guard<std::mutex> lock(job->mutex);
+      send_json(res, 200, jobs.status_json(*job));
+    });
+  });
+
+  svr.Get(R"(/api/jobs/([^/]+)/image\.(png|exr))", [&](const httplib::Request& req, httplib::Response& res) {
+    guarded(res, [&] {
+      auto job = jobs.get(req.matches[1]);
+      if (!job) throw ApiError(404, "no job '" + std::string(req.matches[1]) + "'");
+      std::string ext = req.matches[2];
+      const char* type = ext == "png" ? "image/png" : "image/x-exr";
+      std::string data;
+      pt::ImageRGB img;
+      {
+        std::lock_guard<std::mutex> lock(job->mutex);
+        bool done = job->state == JobState::done;
+        if (!done && !job->has_image) throw ApiError(404, "job has no image yet (state " + std::string(job_state_name(job->state)) + ")");
+        if (!done || !read_file(jobs.job_dir(job->id) + "/image." + ext, data)) {
+          if (!job->has_image) throw ApiError(404, "the job's image is missing");
+          img.width = job->width;
+          img.height = job->height;
+          if (ext == "png") {
+            std::vector<uint8_t> rgb = job->display;
+            data.clear();
+            img.pixels.clear();
+            res.set_header("Cache-Control", "no-store");
+            std::string png = pt::encode_png8(rgb, img.width, img.height);
+            res.set_content(png, type);
+            return;
+          }
+          img.pixels.resize(size_t(img.width) * img.height);
+          std::memcpy(img.pixels.data(), job->linear.data(), img.pixels.size() * sizeof(pt::Vec3));
+        }
+      }
+      if (data.empty()) data = pt::encode_exr(img);
+      res.set_header("Cache-Control", "no-store");
+      res.set_content(data, type);
+    });
+  });
+
+  svr.Get(R"(/api/jobs/([^/]+)/focus)", [&](const httplib::Request& req, httplib::Response& res) {
+    guarded(res, [&] {
+      auto job = jobs.get(req.matches[1]);
+      if (!job) throw ApiError(404, "no job '" + std::string(req.matches[1]) + "'");
+      auto coord = [&](const char* name) {
+        if (!req.has_param(name)) throw ApiError(400, std::string("query parameter '") + name + "' is required", name);
+        std::string v = req.get_param_value(name);
+        char* end = nullptr;
+        double d = std::strtod(v.c_str(), &end);
+        if (v.empty() || *end != '\0' || !std::isfinite(d))
+          throw ApiError(400, std::string("query parameter '") + name + "' must be a number", name);
+        return d;
+      };
+      double x = coord("x"), y = coord("y");
+      double d = jobs.focus_distance(*job, x, y);
+      send_json(res, 200, {{"x", x}, {"y", y}, {"distance", std::isfinite(d) ? json(d) : json(nullptr)}});
+    });
+  });
+
+  svr.Get(R"(/api/jobs/([^/]+)/events)", [&](const httplib::Request& req, httplib::Response& res) {
+    auto job = jobs.get(req.matches[1]);
+    if (!job) return send_error(res, 404, "no job '" + std::string(req.matches[1]) + "'");
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Accel-Buffering", "no");
+    res.set_chunked_content_provider("text/event-stream", [&jobs, job](size_t, httplib::DataSink& sink) {
+      stream_events(jobs, job, sink);
+      sink.done();
+      return true;
+    });
+  });
+
+  svr.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (!res.body.empty()) return;  // a handler already wrote its JSON error
+    if (req.path.rfind("/api/", 0) == 0 || res.status != 404)
+      send_error(res, res.status, res.status == 404 ? "no such endpoint: " + req.method + " " + req.path
+                                                    : "request rejected (" + std::to_string(res.status) + ")");
+  });
+
+  svr.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
+    std::string what = "internal error";
+    try {
+      if (ep) std::rethrow_exception(ep);
+    } catch (const std::exception& e) {
+      what = e.what();
+    } catch (...) {
+    }
+    send_error(res, 500, what);
+  });
+}
+
+}  // namespace srv

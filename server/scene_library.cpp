@@ -1,0 +1,111 @@
+// Scene name resolution, the shared scene cache, and the scene list for GET /api/scenes.
+#include "scene_library.h"
+
+#include <dirent.h>
+#include <sys/stat.h>
+
+#include <climits>
+#include <cstdlib>
+#include <set>
+
+#include "camera.h"
+#include "collada.h"
+
+namespace srv {
+
+namespace {
+
+std::string canonical(const std::string& path) {
+  char buf[PATH_MAX];
+  return realpath(path.c_str(), buf) ? std::string(buf) : std::string();
+}
+
+json summarize(const pt::SceneDesc& d) {
+  std::set<std::string> mats, lights;
+  for (const pt::MeshDesc& m : d.meshes)
+    for (int t : m.tri_material) mats.insert(pt::material_type_name(d.materials[t].type));
+  for (const pt::SphereDesc& s : d.spheres) mats.insert(pt::material_type_name(d.materials[s.material].type));
+  for (const pt::LightDesc& l : d.lights) lights.insert(pt::light_type_name(l.type));
+  pt::Camera cam = pt::make_camera(d, pt::CameraParams());
+  pt::Bounds3 b = d.geometry_bounds();
+  float focus = b.empty() ? 0.0f : pt::length(b.center() - cam.position);
+  return json{{"triangles", d.triangle_count()},
+              {"spheres", d.spheres.size()},
+              {"lights", std::vector<std::string>(lights.begin(), lights.end())},
+              {"materials", std::vector<std::string>(mats.begin(), mats.end())},
+              {"has_camera", d.camera.present},
+              {"center_distance", focus}};
+}
+
+}  // namespace
+
+SceneLibrary::SceneLibrary(std::vector<std::string> dirs) {
+  for (const std::string& d : dirs) {
+    std::string c = canonical(d);
+    if (!c.empty()) m_dirs.push_back(c);
+  }
+}
+
+std::string SceneLibrary::resolve(const std::string& name) const {
+  if (!valid_scene_name(name)) return "";
+  for (const std::string& dir : m_dirs) {
+    std::string real = canonical(dir + "/" + name + ".dae");
+    // The real file must lie inside the directory: a symlink pointing out is refused.
+    if (!real.empty() && real.compare(0, dir.size() + 1, dir + "/") == 0) {
+      struct stat st;
+      if (stat(real.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return real;
+    }
+  }
+  return "";
+}
+
+std::shared_ptr<const pt::SceneDesc> SceneLibrary::load(const std::string& name) {
+  std::string path = resolve(name);
+  if (path.empty()) throw ApiError(404, "unknown scene '" + name + "'", "scene");
+  struct stat st;
+  if (stat(path.c_str(), &st) != 0) throw ApiError(404, "unknown scene '" + name + "'", "scene");
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    auto it = m_cache.find(name);
+    if (it != m_cache.end() && it->second.path == path && it->second.mtime == (long long)st.st_mtime &&
+        it->second.size == (long long)st.st_size && it->second.desc)
+      return it->second.desc;
+  }
+  // Load outside the lock: a big scene must not block status requests.
+  auto desc = std::make_shared<const pt::SceneDesc>(pt::load_collada(path));
+  Entry e{path, (long long)st.st_mtime, (long long)st.st_size, desc, summarize(*desc)};
+  std::lock_guard<std::mutex> lock(m_mutex);
+  m_cache[name] = e;
+  return desc;
+}
+
+json SceneLibrary::list() {
+  std::set<std::string> names;
+  for (const std::string& dir : m_dirs) {
+    DIR* d = opendir(dir.c_str());
+    if (!d) continue;
+    while (dirent* e = readdir(d)) {
+      std::string f = e->d_name;
+      if (f.size() > 4 && f.compare(f.size() - 4, 4, ".dae") == 0) {
+        std::string name = f.substr(0, f.size() - 4);
+        if (valid_scene_name(name)) names.insert(name);
+      }
+    }
+    closedir(d);
+  }
+  json out = json::array();
+  for (const std::string& name : names) {
+    json item{{"name", name}};
+    try {
+      load(name);
+      std::lock_guard<std::mutex> lock(m_mutex);
+      item["summary"] = m_cache[name].summary;
+    } catch (const std::exception& e) {
+      item["error"] = e.what();
+    }
+    out.push_back(item);
+  }
+  return out;
+}
+
+}  // namespace srv
