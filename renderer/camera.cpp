@@ -137,6 +137,7 @@ Ray Camera::generate_ray(float sx, float sy, Vec2 lens_u) const {
   Vec2 d = sample_concentric_disk(lens_u);
   Vec3 lens(lens_radius * d.x, lens_radius * d.y, 0);
   Vec3 dir = focus - lens;
+  if (!(length_squared(dir) > 0)) dir = dc;  // focal distance 0 at the lens centre: no direction left
   Ray r;
   r.o = position + right * lens.x + up * lens.y;
   r.d = normalize(right * dir.x + up * dir.y + back * dir.z);
