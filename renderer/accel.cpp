@@ -5,6 +5,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <atomic>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -23,6 +24,12 @@ void on_device_error(void* user, RTCError code, const char* str) {
   auto* err = static_cast<DeviceError*>(user);
   std::lock_guard<std::mutex> lock(err->mutex);
   if (err->message.empty()) err->message = "Embree error " + std::to_string(int(code)) + ": " + (str ? str : "");
+}
+
+// Embree reports every allocation (BVH and its own geometry buffers) here: the true footprint.
+bool on_memory(void* user, ssize_t bytes, bool) {
+  static_cast<std::atomic<long long>*>(user)->fetch_add(bytes, std::memory_order_relaxed);
+  return true;
 }
 
 enum class GeomKind { mesh, spheres, panels };
@@ -45,7 +52,8 @@ struct Accel::Impl {
   RTCScene scene = nullptr;
   DeviceError error;
   std::vector<GeomInfo> geoms;  // indexed by Embree geometry id
-  size_t bytes = 0;
+  size_t bytes = 0;             // our side arrays (shading normals, per-triangle material and light)
+  std::atomic<long long> embree_bytes{0};
 
   void check(const char* what) {
     std::lock_guard<std::mutex> lock(error.mutex);
@@ -64,6 +72,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
   a.device = rtcNewDevice(nullptr);
   if (!a.device) throw std::runtime_error("Embree: cannot create device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
   rtcSetDeviceErrorFunction(a.device, on_device_error, &a.error);
+  rtcSetDeviceMemoryMonitorFunction(a.device, on_memory, &a.embree_bytes);
   a.scene = rtcNewScene(a.device);
   rtcSetSceneFlags(a.scene, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(a.scene, RTC_BUILD_QUALITY_MEDIUM);
@@ -77,8 +86,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     a.check("allocating triangle buffers");
     std::memcpy(vb, pos.data(), pos.size() * sizeof(Vec3));
     std::memcpy(ib, idx.data(), idx.size() * sizeof(uint32_t));
-    a.bytes += pos.size() * sizeof(Vec3) + idx.size() * sizeof(uint32_t) + info.normals.size() * sizeof(Vec3) +
-               (info.tri_material.size() + info.tri_light.size()) * sizeof(int);
+    a.bytes += info.normals.size() * sizeof(Vec3) + (info.tri_material.size() + info.tri_light.size()) * sizeof(int);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a.scene, g);
     rtcReleaseGeometry(g);
@@ -138,7 +146,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
       vb[4 * i + 3] = s.radius;
       info.sphere_material.push_back(s.material);
     }
-    a.bytes += desc.spheres.size() * (4 * sizeof(float) + sizeof(int));
+    a.bytes += desc.spheres.size() * sizeof(int);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a.scene, g);
     rtcReleaseGeometry(g);
@@ -155,10 +163,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
 Accel::~Accel() = default;
 
 size_t Accel::memory_bytes() const {
-  // Embree does not report BVH size; estimate ~ 64 bytes per primitive for a MEDIUM-quality BVH.
-  size_t prims = 0;
-  for (const GeomInfo& g : m_impl->geoms) prims += g.tri_material.size() + g.sphere_material.size();
-  return m_impl->bytes + prims * 64;
+  return m_impl->bytes + size_t(std::max(0LL, m_impl->embree_bytes.load()));
 }
 
 namespace {

@@ -41,7 +41,8 @@ class Accel {
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
   // True when anything blocks the ray within [ray.tmin, ray.tmax].
   bool occluded(const Ray& ray) const;
-  // Bytes held by geometry buffers and the BVH (approximate, for --describe).
+  // Bytes held for rendering: everything Embree allocated (BVH, vertex and index buffers, as its
+  // memory monitor reports) plus our per-triangle shading data.
   size_t memory_bytes() const;
 
   struct Impl;

@@ -12,6 +12,34 @@ namespace pt {
 
 namespace {
 
+// BSDF dispatch reduced to the material kinds the scene has (feature bits, render.h): a scene
+// without microfacet or delta materials calls the inline Lambertian lobe directly.
+template <uint32_t F>
+inline bool has_delta(const Material& m) {
+  if constexpr ((F & kFeatDelta) != 0) return is_delta(m);
+  else return false;
+}
+template <uint32_t F>
+inline bool has_transmission(const Material& m) {
+  if constexpr ((F & kFeatDelta) != 0) return is_transmissive(m);
+  else return false;
+}
+template <uint32_t F>
+inline Vec3 eval_f(const Material& m, Vec3 wo, Vec3 wi) {
+  if constexpr ((F & kFeatMicrofacet) != 0) return eval_bsdf(m, wo, wi);
+  else return m.type == MaterialType::diffuse ? diffuse_eval(m, wo, wi) : Vec3(0.0f);
+}
+template <uint32_t F>
+inline float pdf_f(const Material& m, Vec3 wo, Vec3 wi) {
+  if constexpr ((F & kFeatMicrofacet) != 0) return bsdf_pdf(m, wo, wi);
+  else return m.type == MaterialType::diffuse ? diffuse_pdf(wo, wi) : 0.0f;
+}
+template <uint32_t F>
+inline bool sample_f(const Material& m, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s) {
+  if constexpr ((F & (kFeatMicrofacet | kFeatDelta)) != 0) return sample_bsdf(m, wo, u_lobe, u, s);
+  else return m.type == MaterialType::diffuse && diffuse_sample(m, wo, u, s);
+}
+
 struct Vertex {
   const SurfaceHit& hit;
   const Material& material;
@@ -25,6 +53,7 @@ int samples_for(const Light& light, const RenderParams& params) {
 }
 
 // Light sampling at a non-delta vertex, every light, MIS-weighted against BSDF sampling.
+template <uint32_t F>
 Vec3 direct_light_sampling(const RenderScene& scene, const RenderParams& params, const Vertex& v, Pcg32& rng,
                            uint64_t& rays) {
   Vec3 sum(0.0f);
@@ -36,12 +65,12 @@ Vec3 direct_light_sampling(const RenderScene& scene, const RenderParams& params,
       if (!sample_light(light, v.hit.p, u, ls)) continue;
       if (dot(ls.wi, v.ng) <= 0) continue;  // below the surface
       Vec3 wi = v.frame.to_local(ls.wi);
-      Vec3 f = eval_bsdf(v.material, v.wo, wi);
+      Vec3 f = eval_f<F>(v.material, v.wo, wi);
       if (is_black(f) || is_black(ls.radiance)) continue;
       Ray shadow = ls.infinite ? spawn_ray(v.hit, ls.wi) : spawn_ray_to(v.hit, ls.point);
       ++rays;
       if (scene.accel->occluded(shadow)) continue;
-      float w = light.is_delta() ? 1.0f : power_heuristic(n * ls.pdf, bsdf_pdf(v.material, v.wo, wi));
+      float w = light.is_delta() ? 1.0f : power_heuristic(n * ls.pdf, pdf_f<F>(v.material, v.wo, wi));
       sum += f * ls.radiance * (std::fabs(wi.z) * w / (ls.pdf * n));
     }
   }
@@ -50,6 +79,7 @@ Vec3 direct_light_sampling(const RenderScene& scene, const RenderParams& params,
 
 // The course's -H estimator: (lights x light_samples) uniform hemisphere rays that count what
 // emits where they land.
+template <uint32_t F>
 Vec3 direct_hemisphere(const RenderScene& scene, const RenderParams& params, const Vertex& v, Pcg32& rng,
                        uint64_t& rays) {
   int n = int(scene.lights.size()) * params.light_samples;
@@ -59,7 +89,7 @@ Vec3 direct_hemisphere(const RenderScene& scene, const RenderParams& params, con
     Vec3 wi = sample_uniform_hemisphere(rng.next_2d());
     Vec3 wi_world = v.frame.to_world(wi);
     if (dot(wi_world, v.ng) <= 0) continue;
-    Vec3 f = eval_bsdf(v.material, v.wo, wi);
+    Vec3 f = eval_f<F>(v.material, v.wo, wi);
     if (is_black(f)) continue;
     SurfaceHit h;
     ++rays;
@@ -68,16 +98,16 @@ Vec3 direct_hemisphere(const RenderScene& scene, const RenderParams& params, con
       const Material& m = scene.materials[h.material];
       le = emitted_radiance(m, Vec3(0, 0, dot(-wi_world, h.ng)));
     } else {
-      for (int i : scene.infinite_lights) le += infinite_light_radiance(scene.lights[i], wi_world);
+      if constexpr ((F & kFeatInfinite) != 0)
+        for (int i : scene.infinite_lights) le += infinite_light_radiance(scene.lights[i], wi_world);
     }
     sum += f * le * wi.z;
   }
   return sum * (2 * kPi / n);
 }
 
-}  // namespace
-
-Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, Pcg32& rng, uint64_t& rays) {
+template <uint32_t F>
+Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray, Pcg32& rng, uint64_t& rays) {
   Vec3 radiance(0.0f), beta(1.0f);
   bool specular = true;  // the camera ray counts as specular: emitters it sees get full weight
   float prev_pdf = 0;
@@ -87,6 +117,7 @@ Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, P
     SurfaceHit hit;
     ++rays;
     if (!scene.accel->intersect(ray, hit)) {
+      if constexpr ((F & kFeatInfinite) == 0) break;
       for (int i : scene.infinite_lights) {
         const Light& light = scene.lights[i];
         if (bounce == 0 && i != scene.environment_light) continue;  // ambient is not seen directly
@@ -122,7 +153,7 @@ Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, P
 
     // Shading frame. Opaque surfaces are two-sided: turn the normals towards the viewer.
     Vec3 ng = hit.ng, ns = hit.ns;
-    bool transmissive = is_transmissive(material);
+    bool transmissive = has_transmission<F>(material);
     if (!transmissive && dot(wo_world, ng) < 0) {
       ng = -ng;
       ns = -ns;
@@ -131,14 +162,14 @@ Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, P
     Vertex v{hit, material, Frame(ns), ng, Vec3()};
     v.wo = v.frame.to_local(wo_world);
 
-    if (!is_delta(material))
-      radiance += beta * (params.hemisphere ? direct_hemisphere(scene, params, v, rng, rays)
-                                            : direct_light_sampling(scene, params, v, rng, rays));
+    if (!has_delta<F>(material))
+      radiance += beta * (params.hemisphere ? direct_hemisphere<F>(scene, params, v, rng, rays)
+                                            : direct_light_sampling<F>(scene, params, v, rng, rays));
 
     BsdfSample bs;
     float u_lobe = rng.next_float();
     Vec2 u = rng.next_2d();
-    if (!sample_bsdf(material, v.wo, u_lobe, u, bs)) break;
+    if (!sample_f<F>(material, v.wo, u_lobe, u, bs)) break;
     Vec3 wi_world = v.frame.to_world(bs.wi);
     // Reflection must leave on the viewer's side of the true surface (no shading-normal leaks).
     if (!transmissive && dot(wi_world, ng) <= 0) break;
@@ -158,6 +189,21 @@ Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, P
     ray = spawn_ray(hit, wi_world);
   }
   return radiance;
+}
+
+}  // namespace
+
+Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, Pcg32& rng, uint64_t& rays) {
+  return trace_path_t<kFeatAll>(scene, params, ray, rng, rays);
+}
+
+PathTracer path_tracer_for(uint32_t bits) {
+  static const PathTracer table[] = {
+      trace_path_t<0>, trace_path_t<1>, trace_path_t<2>, trace_path_t<3>,
+      trace_path_t<4>, trace_path_t<5>, trace_path_t<6>, trace_path_t<7>,
+  };
+  static_assert(sizeof(table) / sizeof(table[0]) == kFeatAll + 1, "one instantiation per feature combination");
+  return table[bits & kFeatAll];
 }
 
 }  // namespace pt

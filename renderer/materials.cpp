@@ -101,7 +101,7 @@ float microfacet_pdf(const Material& m, Vec3 wo, Vec3 wi) {
 Vec3 eval_bsdf(const Material& m, Vec3 wo, Vec3 wi) {
   switch (m.type) {
     case MaterialType::diffuse:
-      return (wo.z > 0 && wi.z > 0) ? m.albedo * kInvPi : Vec3(0.0f);
+      return diffuse_eval(m, wo, wi);
     case MaterialType::microfacet:
       return microfacet_f(m, wo, wi);
     case MaterialType::mirror:
@@ -116,7 +116,7 @@ Vec3 eval_bsdf(const Material& m, Vec3 wo, Vec3 wi) {
 float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi) {
   switch (m.type) {
     case MaterialType::diffuse:
-      return wo.z > 0 ? cosine_hemisphere_pdf(wi.z) : 0;
+      return diffuse_pdf(wo, wi);
     case MaterialType::microfacet:
       return microfacet_pdf(m, wo, wi);
     case MaterialType::mirror:
@@ -131,14 +131,8 @@ float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi) {
 bool sample_bsdf(const Material& m, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s) {
   s.delta = false;
   switch (m.type) {
-    case MaterialType::diffuse: {
-      if (wo.z <= 0) return false;
-      s.wi = sample_cosine_hemisphere(u);
-      s.pdf = cosine_hemisphere_pdf(s.wi.z);
-      if (s.pdf <= 0) return false;
-      s.weight = m.albedo;  // (albedo / pi) * cos / (cos / pi)
-      return true;
-    }
+    case MaterialType::diffuse:
+      return diffuse_sample(m, wo, u, s);
     case MaterialType::microfacet: {
       if (wo.z <= 0) return false;
       float a2 = m.alpha * m.alpha;

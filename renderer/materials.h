@@ -6,6 +6,7 @@
 #pragma once
 
 #include "math.h"
+#include "sampling.h"
 #include "scene.h"
 
 namespace pt {
@@ -16,6 +17,22 @@ struct BsdfSample {
   float pdf = 0;    // solid-angle pdf, or the discrete lobe probability for delta lobes
   bool delta = false;
 };
+
+// The Lambertian lobe, inline so that integrators specialised for diffuse-only scenes call it
+// directly; the switches in materials.cpp use the same functions.
+inline Vec3 diffuse_eval(const Material& m, Vec3 wo, Vec3 wi) {
+  return (wo.z > 0 && wi.z > 0) ? m.albedo * kInvPi : Vec3(0.0f);
+}
+inline float diffuse_pdf(Vec3 wo, Vec3 wi) { return wo.z > 0 ? cosine_hemisphere_pdf(wi.z) : 0; }
+inline bool diffuse_sample(const Material& m, Vec3 wo, Vec2 u, BsdfSample& s) {
+  s.delta = false;
+  if (wo.z <= 0) return false;
+  s.wi = sample_cosine_hemisphere(u);
+  s.pdf = cosine_hemisphere_pdf(s.wi.z);
+  if (s.pdf <= 0) return false;
+  s.weight = m.albedo;  // (albedo / pi) * cos / (cos / pi)
+  return true;
+}
 
 // True when the material has only delta lobes (no eval, no light sampling).
 bool is_delta(const Material& m);

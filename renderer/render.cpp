@@ -98,6 +98,9 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
     for (size_t t = 0; t < mesh.tri_material.size(); ++t) {
       int mat = mesh.tri_material[t];
       if (!is_emissive(rs->materials[mat])) continue;
+      const uint32_t* vi = &mesh.indices[3 * t];
+      if (!(length(cross(mesh.positions[vi[1]] - mesh.positions[vi[0]], mesh.positions[vi[2]] - mesh.positions[vi[0]])) > 0))
+        continue;  // a zero-area triangle cannot emit
       auto it = light_of_material.find(mat);
       if (it == light_of_material.end()) {
         Light l;
@@ -167,6 +170,13 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
   f.thin_lens = params.lens_radius > 0;
   f.adaptive = params.adaptive && params.spp > params.adaptive_batch;
   for (const MeshDesc& m : desc.meshes) f.shading_normals |= !m.normals.empty();
+  f.bits = 0;
+  for (const Material& m : rs->materials) {
+    if (is_delta(m)) f.bits |= kFeatDelta;
+    if (m.type == MaterialType::microfacet) f.bits |= kFeatMicrofacet;
+  }
+  if (!rs->infinite_lights.empty()) f.bits |= kFeatInfinite;
+  if (params.generic) f.bits = kFeatAll;
   rs->triangle_count = desc.triangle_count();
   rs->sphere_count = desc.spheres.size();
   return rs;
@@ -202,6 +212,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
   const RenderParams& p = m_params;
   const Camera& cam = m_scene.camera;
   const bool adaptive = p.adaptive;
+  const PathTracer trace = path_tracer_for(m_scene.features.bits);
   const int batch = std::max(1, p.adaptive_batch);
   for (int y = t.y0; y < t.y1; ++y) {
     if (cancel && cancel->load(std::memory_order_relaxed)) return;
@@ -219,7 +230,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
         Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
         Vec2 lens = rng.next_2d();
         Ray ray = cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
-        Vec3 l = trace_path(m_scene, p, ray, rng, rays);
+        Vec3 l = trace(m_scene, p, ray, rng, rays);
         if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
           ++nonfinite;
           l = Vec3(0.0f);
@@ -321,18 +332,25 @@ ImageRGB RenderSession::image() const {
   return img;
 }
 
+// Course colouring: 0 = blue, 0.5 = green, 1 = red, by samples taken / spp.
+static Vec3 rate_colour(uint32_t count, int spp) {
+  float r = float(count) / float(spp);
+  return r <= 0.5f ? Vec3(0, 2 * r, 1 - 2 * r) : Vec3(2 * r - 1, 2 - 2 * r, 0);
+}
+
 ImageRGB RenderSession::rate_image() const {
-  // Course colouring: 0 = blue, 0.5 = green, 1 = red, by samples taken / spp.
   ImageRGB img;
   img.width = m_w;
   img.height = m_h;
   img.pixels.resize(m_sum.size());
-  for (size_t i = 0; i < m_sum.size(); ++i) {
-    float r = float(m_count[i]) / float(m_params.spp);
-    Vec3 c = r <= 0.5f ? Vec3(0, 2 * r, 1 - 2 * r) : Vec3(2 * r - 1, 2 - 2 * r, 0);
-    img.pixels[i] = c;
-  }
+  for (size_t i = 0; i < m_sum.size(); ++i) img.pixels[i] = rate_colour(m_count[i], m_params.spp);
   return img;
+}
+
+void RenderSession::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const {
+  out.clear();
+  for (int y = t.y0; y < t.y1; ++y)
+    for (int x = t.x0; x < t.x1; ++x) out.push_back(rate_colour(m_count[size_t(y) * m_w + x], m_params.spp));
 }
 
 double RenderSession::error_estimate() const {

@@ -35,15 +35,25 @@ struct RenderParams {
   int cell_x = 0, cell_y = 0, cell_w = 0, cell_h = 0;  // -p: window, bottom-left origin; w = 0: full frame
   uint64_t seed = 0;               // --seed
   int tile_size = 32;
+  bool generic = false;            // --generic: the path loop with every feature (for comparisons)
 
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;
+};
+
+// Feature bits the path loop is specialised on: a scene pays only for what it has.
+enum FeatureBits : uint32_t {
+  kFeatDelta = 1,        // mirror, glass or refraction materials
+  kFeatMicrofacet = 2,   // microfacet materials
+  kFeatInfinite = 4,     // ambient or environment lights (escaping rays look them up)
+  kFeatAll = 7,
 };
 
 struct SceneFeatures {
   std::vector<std::string> materials, lights;
   bool spheres = false, meshes = false, environment = false, thin_lens = false;
   bool adaptive = false, shading_normals = false;
+  uint32_t bits = kFeatAll;  // which specialised path loop runs
 };
 
 struct RenderScene {
@@ -66,8 +76,11 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
 // infinity: what autofocus sets the focal distance to, as in the course.
 float autofocus_distance(const RenderScene& scene, float sx, float sy);
 
-// One camera path's radiance (integrator.cpp). `rays` counts every ray cast.
+// One camera path's radiance (integrator.cpp), by the generic loop. `rays` counts every ray cast.
 Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, class Pcg32& rng, uint64_t& rays);
+// The path loop specialised for a set of feature bits (one instantiation per combination).
+using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class Pcg32&, uint64_t&);
+PathTracer path_tracer_for(uint32_t feature_bits);
 
 struct Tile {
   int x0, y0, x1, y1;  // film pixels, top-left origin, half-open
@@ -104,6 +117,8 @@ class RenderSession {
   // Mean radiance of a tile's pixels, row by row. Safe inside on_tile for that tile (its worker
   // has finished it for this pass) and whenever no pass is running.
   void read_tile(const Tile& t, std::vector<Vec3>& out) const;
+  // The rate image's colours for a tile's pixels, row by row; safe where read_tile is.
+  void read_tile_rate(const Tile& t, std::vector<Vec3>& out) const;
 
  private:
   void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
