@@ -5,6 +5,8 @@
 #include <sys/stat.h>
 
 #include <climits>
+#include <fstream>
+#include <sstream>
 #include <cstdlib>
 #include <set>
 
@@ -62,20 +64,35 @@ std::string SceneLibrary::resolve(const std::string& name) const {
 std::shared_ptr<const pt::SceneDesc> SceneLibrary::load(const std::string& name) {
   std::string path = resolve(name);
   if (path.empty()) throw ApiError(404, "unknown scene '" + name + "'", "scene");
-  struct stat st;
-  if (stat(path.c_str(), &st) != 0) throw ApiError(404, "unknown scene '" + name + "'", "scene");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) throw ApiError(404, "scene '" + name + "' cannot be read", "scene");
+  std::string bytes = text.str();
+  // FNV-1a over the content: an edited file is parsed again; identical files share one parse.
+  uint64_t hash = 1469598103934665603ull;
+  for (unsigned char ch : bytes) hash = (hash ^ ch) * 1099511628211ull;
   {
     std::lock_guard<std::mutex> lock(m_mutex);
-    auto it = m_cache.find(name);
-    if (it != m_cache.end() && it->second.path == path && it->second.mtime == (long long)st.st_mtime &&
-        it->second.size == (long long)st.st_size && it->second.desc)
+    auto it = m_cache.find(hash);
+    if (it != m_cache.end()) {
+      m_last_hash[name] = hash;
       return it->second.desc;
+    }
   }
-  // Load outside the lock: a big scene must not block status requests.
-  auto desc = std::make_shared<const pt::SceneDesc>(pt::load_collada(path));
-  Entry e{path, (long long)st.st_mtime, (long long)st.st_size, desc, summarize(*desc)};
+  // Parse outside the lock: a big scene must not block status requests. Messages name the
+  // scene, not the server's paths.
+  auto desc = std::make_shared<const pt::SceneDesc>(pt::parse_collada(bytes, name + ".dae"));
+  Entry e{desc, summarize(*desc)};
   std::lock_guard<std::mutex> lock(m_mutex);
-  m_cache[name] = e;
+  m_cache[hash] = e;
+  m_last_hash[name] = hash;
+  // Forget contents no scene name points to any more (running jobs keep their own reference).
+  for (auto it = m_cache.begin(); it != m_cache.end();) {
+    bool used = false;
+    for (const auto& kv : m_last_hash) used |= kv.second == it->first;
+    it = used ? std::next(it) : m_cache.erase(it);
+  }
   return desc;
 }
 
@@ -99,7 +116,7 @@ json SceneLibrary::list() {
     try {
       load(name);
       std::lock_guard<std::mutex> lock(m_mutex);
-      item["summary"] = m_cache[name].summary;
+      item["summary"] = m_cache[m_last_hash[name]].summary;
     } catch (const std::exception& e) {
       item["error"] = e.what();
     }

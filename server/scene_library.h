@@ -1,5 +1,5 @@
 // Scene files the server may render: names resolved only inside the configured directories
-// (no paths, no symlinks out), loaded once and shared between jobs while the file is unchanged.
+// (no paths, no symlinks out), parsed once per distinct file content and shared between jobs.
 #pragma once
 
 #include <map>
@@ -25,14 +25,13 @@ class SceneLibrary {
 
  private:
   struct Entry {
-    std::string path;
-    long long mtime = 0, size = 0;
     std::shared_ptr<const pt::SceneDesc> desc;
     json summary;
   };
   std::vector<std::string> m_dirs;  // canonical
   std::mutex m_mutex;
-  std::map<std::string, Entry> m_cache;  // by name
+  std::map<uint64_t, Entry> m_cache;            // by content hash
+  std::map<std::string, uint64_t> m_last_hash;  // scene name -> hash of its last loaded content
 };
 
 }  // namespace srv
