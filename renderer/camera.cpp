@@ -114,6 +114,8 @@ Camera make_camera(const SceneDesc& scene, const CameraParams& p) {
     set_basis(c, dir, Vec3(0, 1, 0));
   }
   // Resizing keeps the angle of a pixel: the FOV follows the output size (course behaviour).
+  // keep_fov instead scales the course's 800-pixel-wide view to the output width.
+  if (p.keep_fov && p.settings_file.empty() && !p.file_camera) c.screen_distance *= float(p.width) / 800.0f;
   c.tan_half_w = (0.5f * p.width) / c.screen_distance;
   c.tan_half_h = (0.5f * p.height) / c.screen_distance;
   return c;

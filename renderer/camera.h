@@ -14,6 +14,7 @@ struct CameraParams {
   float lens_radius = 0;           // -b; 0 is a pinhole
   float focal_distance = 4.7f;     // -d: plane of focus, world units along the view axis
   bool file_camera = false;        // use the scene file's camera pose and FOV as authored
+  bool keep_fov = false;           // -r scales the course's 800x600 view instead of cropping it
   std::string settings_file;       // -c: course camera settings file
 };
 

@@ -153,6 +153,7 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
   cp.lens_radius = params.lens_radius;
   cp.focal_distance = params.focal_distance;
   cp.file_camera = params.file_camera;
+  cp.keep_fov = params.keep_fov;
   cp.settings_file = params.camera_file;
   rs->camera = make_camera(desc, cp);
 

@@ -174,3 +174,18 @@ TEST(Camera, CBdragonDefaultFocusIsOnTheDragon) {
   EXPECT_LT(lo, 4.5f);
   EXPECT_GT(hi, 4.5f);
 }
+
+TEST(Camera, KeepFovScalesTheCourseViewInsteadOfCropping) {
+  SceneDesc s = box_scene();
+  CameraParams p;
+  Camera full = make_camera(s, p);
+  p.width = 480;
+  p.height = 360;
+  p.keep_fov = true;
+  Camera scaled = make_camera(s, p);
+  EXPECT_NEAR(scaled.tan_half_w, full.tan_half_w, 1e-6);
+  EXPECT_NEAR(scaled.tan_half_h, full.tan_half_h, 1e-6);
+  p.keep_fov = false;
+  Camera cropped = make_camera(s, p);
+  EXPECT_NEAR(cropped.tan_half_w, full.tan_half_w * 0.6f, 1e-6);
+}
