@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 
 namespace pt {
 
@@ -73,6 +74,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--seed") { need(a, 1); p.seed = uint64_t(parse_int(a, args[++i], 0, 0x7fffffffffffffffL)); }
     else if (a == "--tile") { need(a, 1); p.tile_size = int(parse_int(a, args[++i], 1, 4096)); }
     else if (a == "--quiet") { o.quiet = true; }
+    else if (a == "--script") { need(a, 1); o.script = args[++i]; }
     else if (a.size() > 1 && a[0] == '-') { throw UsageError("unknown option '" + a + "'"); }
     else {
       if (!o.scene_path.empty()) throw UsageError("more than one scene file given ('" + o.scene_path + "', '" + a + "')");
@@ -104,7 +106,7 @@ std::string usage_text(const std::string& program) {
 "  -d <FLOAT>      thin-lens focal distance: plane of focus along the view axis (default 4.7)\n"
 "  -f <FILE>       render once to FILE (.png with the course's tone mapping, or .exr linear\n"
 "                  with metadata) plus FILE minus 4 characters + '_rate.png';\n"
-"                  without -f the GLFW debug window opens\n"
+"                  without -f the GLFW debug window opens (keys below)\n"
 "  -r <W> <H>      output size (default 800 600); keeps the course's pixel angle, so a\n"
 "                  smaller size is a centred crop of the 800x600 view\n"
 "  -c <PATH>       camera settings file (the course's six-line format)\n"
@@ -119,7 +121,55 @@ std::string usage_text(const std::string& program) {
 "                  the course's framing (which orbits the bounding box at 1.5x its diagonal)\n"
 "  --seed <INT>    random seed (default 0); the same seed gives the same image at any -t\n"
 "  --tile <INT>    tile size in pixels (default 32)\n"
-"  --quiet         no progress bar\n";
+"  --quiet         no progress bar\n"
+"  --script <FILE> window only: replay input from FILE, one command a line (for tests):\n"
+"                  wait_spp N | wait_ms N | key K | click X Y | resize W H | sync |\n"
+"                  title | screenshot FILE.png | close | quit\n"
+"\n"
+"Window keys (without -f; the render restarts after each change):\n" + window_keys_text() +
+"  The render follows the window's size: -r gives the initial window size.\n";
+}
+
+std::string window_keys_text() {
+  return
+"  R               restart the render\n"
+"  . / ,           max ray depth +1 / -1 (min 0)\n"
+"  L / K           lens radius +0.05 / -0.05 (min 0)\n"
+"  ' / ;           focal distance +0.1 / -0.1 (min 0): focal plane farther / nearer\n"
+"  ] / [           samples per pixel x2 / /2\n"
+"  = / -           light samples x2 / /2\n"
+"  T               toggle the sample-rate view\n"
+"  S               save <scene>_screenshot_<M>-<D>_<h>-<m>-<s>.png, .exr and _rate.png\n"
+"  D               write the camera settings to <scene>_cam_settings.txt\n"
+"  click           focus the thin lens on the surface under the cursor (autofocus)\n"
+"  H               list these keys\n"
+"  Esc / Q         quit\n";
+}
+
+Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
+  const RenderParams& p = o.params;
+  SessionStats st = session.stats();
+  auto num = [](double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  double pixels = double(session.width()) * session.height();
+  return {{"pathtracer:scene", o.scene_path},
+          {"pathtracer:spp", std::to_string(p.spp)},
+          {"pathtracer:achieved_spp", num(pixels > 0 ? st.samples / pixels : 0)},
+          {"pathtracer:light_samples", std::to_string(p.light_samples)},
+          {"pathtracer:max_depth", std::to_string(p.max_depth)},
+          {"pathtracer:lens_radius", num(p.lens_radius)},
+          {"pathtracer:focal_distance", num(p.focal_distance)},
+          {"pathtracer:adaptive", p.adaptive ? std::to_string(p.adaptive_batch) + " " + num(p.adaptive_tolerance) : "off"},
+          {"pathtracer:direct", p.hemisphere ? "hemisphere" : "light sampling"},
+          {"pathtracer:environment", p.env_map},
+          {"pathtracer:seed", std::to_string(p.seed)},
+          {"pathtracer:threads", std::to_string(p.threads)},
+          {"pathtracer:wall_seconds", num(st.seconds)},
+          {"pathtracer:error_estimate", num(session.error_estimate())},
+          {"pathtracer:nonfinite_samples", std::to_string(st.nonfinite)}};
 }
 
 std::string rate_image_path(const std::string& output) {

@@ -15,6 +15,7 @@ struct CliOptions {
   std::string output;      // -f; empty opens the debug window
   bool help = false;
   bool quiet = false;      // --quiet: no progress bar
+  std::string script;      // --script: window input replayed from a file (tests)
 };
 
 class UsageError : public std::runtime_error {
@@ -25,6 +26,10 @@ class UsageError : public std::runtime_error {
 // Parses argv; throws UsageError naming the flag on anything malformed.
 CliOptions parse_cli(const std::vector<std::string>& args);
 std::string usage_text(const std::string& program);
+// The debug window's keys, one a line (part of usage_text; the window's H key prints it).
+std::string window_keys_text();
+// The EXR header of a render: its parameters, achieved samples, wall time and error estimate.
+Metadata render_metadata(const CliOptions& options, const RenderSession& session);
 // The course's rate-image name: drop the last 4 characters of the output name, add "_rate.png".
 std::string rate_image_path(const std::string& output);
 

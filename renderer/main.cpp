@@ -1,44 +1,15 @@
-// The pathtracer command: course flags -> load scene -> render -> write images -> summary line.
+// The pathtracer command: course flags -> load scene -> render -> write images -> summary line;
+// without -f, the debug window (viewer.cpp).
 #include <chrono>
 #include <cstdio>
-#include <sstream>
 
 #include "cli.h"
 #include "collada.h"
 #include "progress.h"
 #include "render.h"
+#include "viewer.h"
 
 using namespace pt;
-
-namespace {
-
-Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
-  const RenderParams& p = o.params;
-  SessionStats st = session.stats();
-  auto num = [](double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-  };
-  double pixels = double(session.width()) * session.height();
-  return {{"pathtracer:scene", o.scene_path},
-          {"pathtracer:spp", std::to_string(p.spp)},
-          {"pathtracer:achieved_spp", num(pixels > 0 ? st.samples / pixels : 0)},
-          {"pathtracer:light_samples", std::to_string(p.light_samples)},
-          {"pathtracer:max_depth", std::to_string(p.max_depth)},
-          {"pathtracer:lens_radius", num(p.lens_radius)},
-          {"pathtracer:focal_distance", num(p.focal_distance)},
-          {"pathtracer:adaptive", p.adaptive ? std::to_string(p.adaptive_batch) + " " + num(p.adaptive_tolerance) : "off"},
-          {"pathtracer:direct", p.hemisphere ? "hemisphere" : "light sampling"},
-          {"pathtracer:environment", p.env_map},
-          {"pathtracer:seed", std::to_string(p.seed)},
-          {"pathtracer:threads", std::to_string(p.threads)},
-          {"pathtracer:wall_seconds", num(st.seconds)},
-          {"pathtracer:error_estimate", num(session.error_estimate())},
-          {"pathtracer:nonfinite_samples", std::to_string(st.nonfinite)}};
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
@@ -53,10 +24,10 @@ int main(int argc, char** argv) {
     std::printf("%s", usage_text(argv[0]).c_str());
     return 0;
   }
-  if (o.output.empty()) {
-    std::fprintf(stderr,
-                 "pathtracer: the GLFW debug window is not part of this build yet; give -f FILE to render to a file\n");
-    return 2;
+  if (o.output.empty()) return run_viewer(o);
+  if (!o.script.empty()) {
+    std::fprintf(stderr, "pathtracer: --script drives the window; it cannot be used with -f\n");
+    return 1;
   }
   try {
     auto t0 = std::chrono::steady_clock::now();

@@ -33,6 +33,18 @@ void RenderParams::validate() const {
   if (tile_size < 1 || tile_size > 4096) bad("tile_size", "must be between 1 and 4096");
 }
 
+CameraParams camera_params(const RenderParams& params) {
+  CameraParams cp;
+  cp.width = params.width;
+  cp.height = params.height;
+  cp.lens_radius = params.lens_radius;
+  cp.focal_distance = params.focal_distance;
+  cp.file_camera = params.file_camera;
+  cp.keep_fov = params.keep_fov;
+  cp.settings_file = params.camera_file;
+  return cp;
+}
+
 std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
   params.validate();
   auto rs = std::make_unique<RenderScene>();
@@ -147,15 +159,7 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
 
   rs->accel = std::make_unique<Accel>(desc, panels, mesh_light);
 
-  CameraParams cp;
-  cp.width = params.width;
-  cp.height = params.height;
-  cp.lens_radius = params.lens_radius;
-  cp.focal_distance = params.focal_distance;
-  cp.file_camera = params.file_camera;
-  cp.keep_fov = params.keep_fov;
-  cp.settings_file = params.camera_file;
-  rs->camera = make_camera(desc, cp);
+  rs->camera = make_camera(desc, camera_params(params));
 
   SceneFeatures& f = rs->features;
   std::set<std::string> mats;

@@ -72,6 +72,8 @@ struct RenderScene {
 // Builds what the integrator needs from the file's description: lights (area lights also as
 // visible panels, emissive meshes as mesh lights), the environment map, the camera, the BVH.
 std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params);
+// The camera part of the render options (what make_render_scene passes to make_camera).
+CameraParams camera_params(const RenderParams& params);
 
 // Distance along the pinhole ray through sensor point (sx, sy) (y up) to the first surface, or
 // infinity: what autofocus sets the focal distance to, as in the course.

@@ -5,6 +5,7 @@ packages=(
   build-essential cmake ninja-build pkg-config python3
   libembree-dev libopenimageio-dev openimageio-tools libpugixml-dev libtbb-dev
   libgtest-dev libcpp-httplib-dev nlohmann-json3-dev libglfw3-dev xvfb
+  libgl1-mesa-dri xauth  # the window tests: Mesa's llvmpipe OpenGL under Xvfb
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,797 @@
+// The GLFW debug window: a render thread runs RenderSession passes of doubling sample targets
+// and hands finished tiles (tone-mapped exactly like the PNG) to the window thread, which
+// uploads them into one texture drawn as a full-window quad (OpenGL 1.x/2.1 calls only, so
+// Mesa's llvmpipe under Xvfb runs it). Keys change RenderParams, cancel the running pass through
+// its cancel flag and start a new session; the window thread never waits on rendering.
+// The render size follows the window's framebuffer (course behaviour); until the new session's
+// first tiles arrive the previous image is stretched to the new size.
+// --script replays window input from a file, so tests can drive the real window under Xvfb.
+#include "viewer.h"
+
+#include <GLFW/glfw3.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdarg>
+#include <condition_variable>
+#include <cstdio>
+#include <ctime>
+#include <deque>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "collada.h"
+#include "render.h"
+
+namespace pt {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+void say(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+void say(const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  std::vfprintf(stdout, fmt, ap);
+  va_end(ap);
+  std::fputc('\n', stdout);
+  std::fflush(stdout);
+}
+
+std::string fmt_g(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// The scene path without ".dae": the course names screenshots and camera files after it.
+std::string scene_base(const std::string& path) {
+  if (path.size() > 4 && path.compare(path.size() - 4, 4, ".dae") == 0) return path.substr(0, path.size() - 4);
+  return path;
+}
+
+// ---- state shared by the window thread and the render thread ----
+
+struct TileUpdate {
+  uint64_t gen;
+  Tile tile;
+  std::vector<uint8_t> rgb, rate;  // tone-mapped radiance and the rate colouring, 3 bytes a pixel
+};
+
+// What the render thread reports about the session it runs.
+struct Status {
+  uint64_t gen = 0;  // 0: no session yet
+  int width = 0, height = 0;
+  int spp = 0;           // the session's target
+  int reached_spp = 0;   // the last completed pass's target
+  bool finished = false;
+  double error = INFINITY, seconds = 0;
+};
+
+enum class CommandKind { focus, save };
+
+struct Command {
+  CommandKind kind;
+  float sx = 0, sy = 0;  // focus: sensor point, y up
+};
+
+struct Shared {
+  std::mutex mutex;
+  std::condition_variable wake;
+  RenderParams want;       // what the window asks for; a change bumps want_gen
+  uint64_t want_gen = 1;
+  std::deque<Command> commands;
+  uint64_t issued = 0, handled = 0;  // commands
+  bool quit = false;
+  std::string fatal;       // a render-thread error that ends the window
+  std::atomic<bool> cancel{false};
+  Status status;
+
+  std::mutex tile_mutex;
+  std::vector<TileUpdate> tiles;
+};
+
+// ---- the render thread ----
+
+class RenderLoop {
+ public:
+  RenderLoop(const CliOptions& o, const SceneDesc& desc, RenderScene& scene, Shared& sh)
+      : m_options(o), m_desc(desc), m_scene(scene), m_sh(sh) {}
+
+  void run() {
+    try {
+      loop();
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      m_sh.fatal = e.what();
+    }
+    glfwPostEmptyEvent();
+  }
+
+ private:
+  void loop() {
+    std::unique_lock<std::mutex> lk(m_sh.mutex);
+    for (;;) {
+      if (m_sh.quit) return;
+      if (!m_sh.commands.empty()) {
+        Command c = m_sh.commands.front();
+        m_sh.commands.pop_front();
+        RenderParams want = m_sh.want;
+        lk.unlock();
+        float focus = handle(c, want);
+        lk.lock();
+        if (c.kind == CommandKind::focus && std::isfinite(focus)) {
+          m_sh.want.focal_distance = focus;
+          ++m_sh.want_gen;
+        }
+        ++m_sh.handled;
+        glfwPostEmptyEvent();
+        continue;
+      }
+      if (!m_session || m_gen != m_sh.want_gen) {
+        RenderParams p = m_sh.want;
+        uint64_t gen = m_sh.want_gen;
+        lk.unlock();
+        start_session(p, gen);
+        lk.lock();
+        continue;
+      }
+      if (m_done) {
+        m_sh.wake.wait(lk);
+        continue;
+      }
+      // Every request is consumed above with the lock held; one made after this line cancels the pass.
+      m_sh.cancel = false;
+      lk.unlock();
+      uint64_t gen = m_gen;
+      RenderSession* s = m_session.get();
+      bool ok = s->render_pass(m_target, &m_sh.cancel, [this, gen, s](const Tile& t) { send_tile(gen, *s, t); });
+      if (ok) {
+        Status st = m_status;
+        st.reached_spp = m_target;
+        st.finished = m_target >= m_params.spp || s->finished();
+        st.error = s->error_estimate();
+        st.seconds = s->stats().seconds;
+        m_status = st;
+        m_done = st.finished;
+        if (!m_options.quiet)
+          say("pass: %d/%d spp, error estimate %.3g, %.2f s", st.reached_spp, st.spp, st.error, st.seconds);
+        m_target = std::min(m_params.spp, m_target * 2);
+      }
+      lk.lock();
+      if (ok) m_sh.status = m_status;
+      glfwPostEmptyEvent();
+    }
+  }
+
+  void start_session(const RenderParams& p, uint64_t gen) {
+    m_session.reset();
+    m_scene.camera = make_camera(m_desc, camera_params(p));
+    m_session = std::make_unique<RenderSession>(m_scene, p);
+    m_params = p;
+    m_gen = gen;
+    m_target = 1;
+    m_done = false;
+    m_status = Status{};
+    m_status.gen = gen;
+    m_status.width = m_session->width();
+    m_status.height = m_session->height();
+    m_status.spp = p.spp;
+    std::lock_guard<std::mutex> lk(m_sh.mutex);
+    m_sh.status = m_status;
+  }
+
+  // Runs on a worker thread right after the tile is finished for this pass.
+  void send_tile(uint64_t gen, const RenderSession& s, const Tile& t) {
+    TileUpdate u{gen, t, {}, {}};
+    std::vector<Vec3> px;
+    s.read_tile(t, px);
+    u.rgb.resize(px.size() * 3);
+    for (size_t i = 0; i < px.size(); ++i)
+      for (int c = 0; c < 3; ++c) u.rgb[3 * i + c] = tonemap_course(px[i][c]);
+    s.read_tile_rate(t, px);
+    u.rate.resize(px.size() * 3);
+    for (size_t i = 0; i < px.size(); ++i)
+      for (int c = 0; c < 3; ++c) u.rate[3 * i + c] = tonemap_course(px[i][c]);  // as the _rate.png
+    bool was_empty;
+    {
+      std::lock_guard<std::mutex> lk(m_sh.tile_mutex);
+      was_empty = m_sh.tiles.empty();
+      m_sh.tiles.push_back(std::move(u));
+    }
+    if (was_empty) glfwPostEmptyEvent();
+  }
+
+  // Runs between passes (the pass was cancelled to get here; it resumes where it stopped).
+  // Returns the autofocus distance for a focus command.
+  float handle(const Command& c, const RenderParams& want) {
+    if (c.kind == CommandKind::focus) {
+      // The pinhole ray of the camera the window shows now (pose and size; lens settings do not matter).
+      Camera current = m_scene.camera;
+      m_scene.camera = make_camera(m_desc, camera_params(want));
+      float d = autofocus_distance(m_scene, c.sx, c.sy);
+      m_scene.camera = current;
+      if (std::isfinite(d))
+        say("autofocus (%.4f, %.4f): focal distance %s", c.sx, c.sy, fmt_g(d).c_str());
+      else
+        say("autofocus (%.4f, %.4f): nothing under the cursor, focal distance unchanged", c.sx, c.sy);
+      return d;
+    }
+    if (!m_session) {
+      say("save: nothing rendered yet");
+      return 0;
+    }
+    std::time_t now = std::time(nullptr);
+    std::tm lt{};
+    localtime_r(&now, &lt);
+    char stamp[64];
+    std::snprintf(stamp, sizeof stamp, "_screenshot_%d-%d_%d-%d-%d", lt.tm_mon + 1, lt.tm_mday, lt.tm_hour, lt.tm_min,
+                  lt.tm_sec);
+    std::string base = scene_base(m_options.scene_path) + stamp;
+    CliOptions o = m_options;
+    o.params = m_params;
+    try {
+      write_image(m_session->image(), base + ".png");
+      write_image(m_session->image(), base + ".exr", render_metadata(o, *m_session));
+      write_image(m_session->rate_image(), rate_image_path(base + ".png"));
+      say("saved %s.png, %s.exr, %s", base.c_str(), base.c_str(), rate_image_path(base + ".png").c_str());
+    } catch (const std::exception& e) {
+      say("save failed: %s", e.what());
+    }
+    return 0;
+  }
+
+  const CliOptions& m_options;
+  const SceneDesc& m_desc;
+  RenderScene& m_scene;  // its camera is rebuilt for each session; only this thread touches it
+  Shared& m_sh;
+  std::unique_ptr<RenderSession> m_session;
+  RenderParams m_params;
+  uint64_t m_gen = 0;
+  int m_target = 1;
+  bool m_done = false;
+  Status m_status;
+};
+
+// ---- the script player ----
+
+struct ScriptLine {
+  int line;
+  std::vector<std::string> words;
+};
+
+int key_code(const std::string& name) {
+  if (name == "Esc" || name == "Escape" || name == "esc") return GLFW_KEY_ESCAPE;
+  if (name.size() != 1) return -1;
+  char c = name[0];
+  if (c >= 'a' && c <= 'z') return GLFW_KEY_A + (c - 'a');
+  if (c >= 'A' && c <= 'Z') return GLFW_KEY_A + (c - 'A');
+  switch (c) {
+    case '.': return GLFW_KEY_PERIOD;
+    case ',': return GLFW_KEY_COMMA;
+    case '\'': return GLFW_KEY_APOSTROPHE;
+    case ';': return GLFW_KEY_SEMICOLON;
+    case '[': return GLFW_KEY_LEFT_BRACKET;
+    case ']': return GLFW_KEY_RIGHT_BRACKET;
+    case '=': return GLFW_KEY_EQUAL;
+    case '-': return GLFW_KEY_MINUS;
+    default: return -1;
+  }
+}
+
+// Reads and checks the whole script up front; throws naming FILE:LINE.
+std::vector<ScriptLine> load_script(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open script");
+  std::vector<ScriptLine> out;
+  std::string text;
+  for (int n = 1; std::getline(in, text); ++n) {
+    std::istringstream ws(text);
+    ScriptLine l{n, {}};
+    for (std::string w; ws >> w;) l.words.push_back(w);
+    if (l.words.empty() || l.words[0][0] == '#') continue;
+    const std::string& c = l.words[0];
+    size_t want_args = c == "wait_spp" || c == "wait_ms" || c == "key" || c == "screenshot" ? 1
+                       : c == "click" || c == "resize"                                          ? 2
+                       : c == "sync" || c == "title" || c == "close" || c == "quit"             ? 0
+                                                                                                 : size_t(-1);
+    std::string where = path + ":" + std::to_string(n) + ": ";
+    if (want_args == size_t(-1)) throw std::runtime_error(where + "unknown command '" + c + "'");
+    if (l.words.size() != want_args + 1)
+      throw std::runtime_error(where + c + " takes " + std::to_string(want_args) + " argument(s)");
+    if (c == "key" && key_code(l.words[1]) < 0) throw std::runtime_error(where + "unknown key '" + l.words[1] + "'");
+    for (size_t i = 1; i < l.words.size() && c != "key" && c != "screenshot"; ++i) {
+      char* end = nullptr;
+      double v = std::strtod(l.words[i].c_str(), &end);
+      if (*end != '\0' || !(v >= 0)) throw std::runtime_error(where + "'" + l.words[i] + "' is not a number >= 0");
+    }
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+// ---- the window thread ----
+
+constexpr double kScriptTimeoutMs = 120000;
+constexpr double kResizeSettleMs = 150;
+
+class Viewer {
+ public:
+  Viewer(const CliOptions& o, const SceneDesc& desc, GLFWwindow* win, std::vector<ScriptLine> script)
+      : m_options(o), m_desc(desc), m_win(win), m_script(std::move(script)) {
+    glfwSetWindowUserPointer(win, this);
+    glfwSetKeyCallback(win, [](GLFWwindow* w, int key, int, int action, int) {
+      if (action != GLFW_RELEASE) self(w)->on_key(key, action == GLFW_REPEAT);
+    });
+    glfwSetMouseButtonCallback(win, [](GLFWwindow* w, int button, int action, int) {
+      if (action != GLFW_RELEASE || (button != GLFW_MOUSE_BUTTON_LEFT && button != GLFW_MOUSE_BUTTON_RIGHT)) return;
+      double x, y;
+      glfwGetCursorPos(w, &x, &y);
+      self(w)->on_click(x, y);
+    });
+    glfwSetFramebufferSizeCallback(win, [](GLFWwindow* w, int width, int height) {
+      Viewer* v = self(w);
+      v->m_resize_w = width;
+      v->m_resize_h = height;
+      v->m_resize_at = Clock::now();
+      v->m_dirty = true;
+    });
+    glfwSetWindowRefreshCallback(win, [](GLFWwindow* w) { self(w)->m_dirty = true; });
+  }
+
+  int run(std::unique_ptr<RenderScene> scene) {
+    int fw, fh;
+    glfwGetFramebufferSize(m_win, &fw, &fh);
+    m_sh.want = m_options.params;
+    m_sh.want.cell_x = m_sh.want.cell_y = m_sh.want.cell_w = m_sh.want.cell_h = 0;
+    m_sh.want.width = std::min(std::max(1, fw), 16384);
+    m_sh.want.height = std::min(std::max(1, fh), 16384);
+    if (m_options.params.cell_w > 0) say("window: -p is ignored; the window renders the whole frame");
+    say("window: %dx%d, %s", m_sh.want.width, m_sh.want.height, settings_text(m_sh.want).c_str());
+
+    glGenTextures(1, &m_tex);
+    RenderLoop loop(m_options, m_desc, *scene, m_sh);
+    std::thread render([&] { loop.run(); });
+    while (!glfwWindowShouldClose(m_win)) {
+      glfwWaitEventsTimeout(0.02);
+      Status st;
+      {
+        std::lock_guard<std::mutex> lk(m_sh.mutex);
+        st = m_sh.status;
+        if (!m_sh.fatal.empty()) {
+          std::fprintf(stderr, "pathtracer: %s\n", m_sh.fatal.c_str());
+          m_exit = 1;
+          break;
+        }
+      }
+      upload_tiles(st);  // after the status snapshot: a completed pass's tiles are all queued by then
+      apply_resize();
+      if (m_script_pos < m_script.size()) step_script(st);
+      if (m_dirty) {
+        draw();
+        glfwSwapBuffers(m_win);
+        m_dirty = false;
+      }
+      update_title(st);
+    }
+    {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      m_sh.quit = true;
+      m_sh.cancel = true;
+    }
+    m_sh.wake.notify_all();
+    render.join();  // the running pass stops within a few samples
+    glDeleteTextures(1, &m_tex);
+    return m_exit;
+  }
+
+ private:
+  static Viewer* self(GLFWwindow* w) { return static_cast<Viewer*>(glfwGetWindowUserPointer(w)); }
+
+  static std::string settings_text(const RenderParams& p) {
+    return "spp " + std::to_string(p.spp) + ", light samples " + std::to_string(p.light_samples) + ", max depth " +
+           std::to_string(p.max_depth) + ", lens radius " + fmt_g(p.lens_radius) + ", focal distance " +
+           fmt_g(p.focal_distance);
+  }
+
+  // Applies a settings change and restarts the render: the running pass is cancelled at once.
+  template <class F>
+  void change(F&& edit) {
+    std::string text;
+    {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      text = edit(m_sh.want);
+      ++m_sh.want_gen;
+      m_sh.cancel = true;
+    }
+    m_sh.wake.notify_all();
+    if (!text.empty()) say("%s", text.c_str());
+  }
+
+  void push_command(const Command& c) {
+    {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      m_sh.commands.push_back(c);
+      ++m_sh.issued;
+      m_sh.cancel = true;  // pause the pass; the render thread resumes it after the command
+    }
+    m_sh.wake.notify_all();
+  }
+
+  void on_key(int key, bool repeat) {
+    if (key != GLFW_KEY_H) m_show_keys = false;
+    switch (key) {
+      case GLFW_KEY_ESCAPE:
+      case GLFW_KEY_Q: glfwSetWindowShouldClose(m_win, GLFW_TRUE); break;
+      case GLFW_KEY_R: change([](RenderParams&) { return std::string("restart"); }); break;
+      case GLFW_KEY_PERIOD:
+        change([](RenderParams& p) {
+          p.max_depth = std::min(p.max_depth + 1, 1000000);
+          return "max depth " + std::to_string(p.max_depth);
+        });
+        break;
+      case GLFW_KEY_COMMA:
+        change([](RenderParams& p) {
+          p.max_depth = std::max(p.max_depth - 1, 0);
+          return "max depth " + std::to_string(p.max_depth);
+        });
+        break;
+      case GLFW_KEY_L: change([](RenderParams& p) { return step_lens(p, +0.05f); }); break;
+      case GLFW_KEY_K: change([](RenderParams& p) { return step_lens(p, -0.05f); }); break;
+      case GLFW_KEY_APOSTROPHE: change([](RenderParams& p) { return step_focus(p, +0.1f); }); break;
+      case GLFW_KEY_SEMICOLON: change([](RenderParams& p) { return step_focus(p, -0.1f); }); break;
+      case GLFW_KEY_RIGHT_BRACKET:
+        change([](RenderParams& p) { p.spp = std::min(p.spp * 2, 1 << 24); return "spp " + std::to_string(p.spp); });
+        break;
+      case GLFW_KEY_LEFT_BRACKET:
+        change([](RenderParams& p) { p.spp = std::max(p.spp / 2, 1); return "spp " + std::to_string(p.spp); });
+        break;
+      case GLFW_KEY_EQUAL:
+        change([](RenderParams& p) {
+          p.light_samples = std::min(p.light_samples * 2, 65536);
+          return "light samples " + std::to_string(p.light_samples);
+        });
+        break;
+      case GLFW_KEY_MINUS:
+        change([](RenderParams& p) {
+          p.light_samples = std::max(p.light_samples / 2, 1);
+          return "light samples " + std::to_string(p.light_samples);
+        });
+        break;
+      default: break;
+    }
+    if (repeat) return;  // the keys below act once per press
+    switch (key) {
+      case GLFW_KEY_T:
+        m_show_rate = !m_show_rate;
+        upload_all();
+        say("view: %s", m_show_rate ? "sample rate" : "radiance");
+        break;
+      case GLFW_KEY_S: push_command({CommandKind::save}); break;
+      case GLFW_KEY_D: write_camera(); break;
+      case GLFW_KEY_H:
+        m_show_keys = !m_show_keys;
+        std::printf("Window keys:\n%s", window_keys_text().c_str());
+        std::fflush(stdout);
+        break;
+      default: break;
+    }
+  }
+
+  static std::string step_lens(RenderParams& p, float step) {
+    p.lens_radius = std::max(0.0f, p.lens_radius + step);
+    if (p.lens_radius < 1e-6f) p.lens_radius = 0;
+    return "lens radius " + fmt_g(p.lens_radius);
+  }
+
+  static std::string step_focus(RenderParams& p, float step) {
+    p.focal_distance = std::min(std::max(0.0f, p.focal_distance + step), 1e12f);
+    if (p.focal_distance < 1e-6f) p.focal_distance = 0;
+    return "focal distance " + fmt_g(p.focal_distance);
+  }
+
+  void on_click(double x, double y) {
+    int ww, wh;
+    glfwGetWindowSize(m_win, &ww, &wh);
+    if (ww <= 0 || wh <= 0 || x < 0 || y < 0 || x > ww || y > wh) return;
+    // Course autofocus: the pinhole ray through the cursor position (window coordinates).
+    push_command({CommandKind::focus, float(x / ww), float(1 - y / wh)});
+  }
+
+  void write_camera() {
+    RenderParams p;
+    {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      p = m_sh.want;
+    }
+    std::string path = scene_base(m_options.scene_path) + "_cam_settings.txt";
+    try {
+      write_camera_settings(make_camera(m_desc, camera_params(p)), path);
+      say("wrote %s", path.c_str());
+    } catch (const std::exception& e) {
+      say("camera settings: %s", e.what());
+    }
+  }
+
+  // Debounced: the render restarts at the new size once the window has stopped changing.
+  void apply_resize() {
+    if (m_resize_w <= 0 || m_resize_h <= 0 || ms_since(m_resize_at) < kResizeSettleMs) return;
+    int w = std::min(m_resize_w, 16384), h = std::min(m_resize_h, 16384);
+    m_resize_w = m_resize_h = 0;
+    bool same;
+    {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      same = m_sh.want.width == w && m_sh.want.height == h;
+    }
+    if (!same)
+      change([w, h](RenderParams& p) {
+        p.width = w;
+        p.height = h;
+        return "size " + std::to_string(w) + "x" + std::to_string(h);
+      });
+  }
+
+  void upload_tiles(const Status& st) {
+    if (st.gen != 0 && st.gen != m_tex_gen) {
+      m_tex_gen = st.gen;
+      if (st.width != m_tex_w || st.height != m_tex_h) {
+        m_tex_w = st.width;
+        m_tex_h = st.height;
+        m_rgb.assign(size_t(m_tex_w) * m_tex_h * 3, 0);
+        m_rate.assign(m_rgb.size(), 0);
+        glBindTexture(GL_TEXTURE_2D, m_tex);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+        glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, m_tex_w, m_tex_h, 0, GL_RGB, GL_UNSIGNED_BYTE, m_rgb.data());
+        m_dirty = true;
+      }
+    }
+    std::vector<TileUpdate> tiles;
+    {
+      std::lock_guard<std::mutex> lk(m_sh.tile_mutex);
+      tiles.swap(m_sh.tiles);
+    }
+    for (const TileUpdate& u : tiles) {
+      if (u.gen != m_tex_gen) continue;  // from a session that was replaced
+      const Tile& t = u.tile;
+      int tw = t.x1 - t.x0;
+      for (int y = t.y0; y < t.y1; ++y) {
+        size_t dst = (size_t(y) * m_tex_w + t.x0) * 3, src = size_t(y - t.y0) * tw * 3;
+        std::copy(u.rgb.begin() + src, u.rgb.begin() + src + tw * 3, m_rgb.begin() + dst);
+        std::copy(u.rate.begin() + src, u.rate.begin() + src + tw * 3, m_rate.begin() + dst);
+      }
+      upload_rect(t.x0, t.y0, tw, t.y1 - t.y0);
+    }
+  }
+
+  void upload_rect(int x, int y, int w, int h) {
+    const std::vector<uint8_t>& src = m_show_rate ? m_rate : m_rgb;
+    if (src.empty()) return;
+    glBindTexture(GL_TEXTURE_2D, m_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, m_tex_w);
+    glPixelStorei(GL_UNPACK_SKIP_PIXELS, x);
+    glPixelStorei(GL_UNPACK_SKIP_ROWS, y);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, x, y, w, h, GL_RGB, GL_UNSIGNED_BYTE, src.data());
+    m_dirty = true;
+  }
+
+  void upload_all() { upload_rect(0, 0, m_tex_w, m_tex_h); }
+
+  // The texture on a full-window quad; texture row 0 is the image's top row.
+  void draw() {
+    int fw, fh;
+    glfwGetFramebufferSize(m_win, &fw, &fh);
+    glViewport(0, 0, fw, fh);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    if (m_tex_w == 0) return;
+    glMatrixMode(GL_PROJECTION);
+    glLoadIdentity();
+    glMatrixMode(GL_MODELVIEW);
+    glLoadIdentity();
+    glDisable(GL_BLEND);
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_TEXTURE_2D);
+    glBindTexture(GL_TEXTURE_2D, m_tex);
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_REPLACE);
+    glColor4f(1, 1, 1, 1);
+    glBegin(GL_QUADS);
+    glTexCoord2f(0, 1); glVertex2f(-1, -1);
+    glTexCoord2f(1, 1); glVertex2f(1, -1);
+    glTexCoord2f(1, 0); glVertex2f(1, 1);
+    glTexCoord2f(0, 0); glVertex2f(-1, 1);
+    glEnd();
+    glDisable(GL_TEXTURE_2D);
+  }
+
+  void update_title(const Status& st) {
+    RenderParams p;
+    bool current;
+    {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      p = m_sh.want;
+      current = st.gen == m_sh.want_gen;
+    }
+    std::string name = m_options.scene_path.substr(m_options.scene_path.find_last_of('/') + 1);
+    char buf[512];
+    if (m_show_keys) {
+      std::snprintf(buf, sizeof buf,
+                    "keys: R restart | . , depth | L K lens | ' ; focus | ] [ spp | = - light samples | T rate view | "
+                    "S save | D camera | click autofocus | Esc/Q quit");
+    } else {
+      char spp[64];
+      if (current && st.finished)
+        std::snprintf(spp, sizeof spp, "%d/%d spp done", st.reached_spp, st.spp);
+      else if (current)
+        std::snprintf(spp, sizeof spp, "%d/%d spp", st.reached_spp, st.spp);
+      else
+        std::snprintf(spp, sizeof spp, "restarting");
+      std::snprintf(buf, sizeof buf,
+                    "pathtracer: %s | %s | error %.3g | depth %d | lens %s | focus %s | light %d | %dx%d%s", name.c_str(),
+                    spp, current ? st.error : INFINITY, p.max_depth, fmt_g(p.lens_radius).c_str(),
+                    fmt_g(p.focal_distance).c_str(), p.light_samples, p.width, p.height,
+                    m_show_rate ? " | rate view" : "");
+    }
+    if (m_title != buf) {
+      m_title = buf;
+      glfwSetWindowTitle(m_win, buf);
+    }
+  }
+
+  // Runs script commands until one has to wait; a failure closes the window with status 1.
+  void step_script(const Status& st) {
+    while (m_script_pos < m_script.size()) {
+      const ScriptLine& l = m_script[m_script_pos];
+      const std::string& c = l.words[0];
+      auto arg = [&](int i) { return std::strtod(l.words[i].c_str(), nullptr); };
+      if (!m_step_started) {
+        m_step_started = true;
+        m_step_at = Clock::now();
+        if (c == "resize") glfwSetWindowSize(m_win, int(arg(1)), int(arg(2)));
+      }
+      bool done = true;
+      if (c == "wait_spp") {
+        std::lock_guard<std::mutex> lk(m_sh.mutex);
+        done = st.gen == m_sh.want_gen && m_sh.handled == m_sh.issued && st.gen == m_tex_gen &&
+               (st.reached_spp >= arg(1) || st.finished);
+      } else if (c == "wait_ms") {
+        done = ms_since(m_step_at) >= arg(1);
+      } else if (c == "sync") {
+        std::lock_guard<std::mutex> lk(m_sh.mutex);
+        done = m_sh.handled == m_sh.issued && st.gen == m_sh.want_gen;
+        if (done) say("sync: %.0f ms", ms_since(m_step_at));
+      } else if (c == "resize") {
+        std::lock_guard<std::mutex> lk(m_sh.mutex);
+        done = m_sh.want.width == int(arg(1)) && m_sh.want.height == int(arg(2)) && m_resize_w == 0;
+      } else if (c == "key") {
+        on_key(key_code(l.words[1]), false);
+      } else if (c == "click") {
+        on_click(arg(1), arg(2));
+      } else if (c == "title") {
+        update_title(st);
+        say("title: %s", m_title.c_str());
+      } else if (c == "screenshot") {
+        screenshot(l.words[1]);
+      } else if (c == "close" || c == "quit") {
+        glfwSetWindowShouldClose(m_win, GLFW_TRUE);
+      }
+      if (!done) {
+        if (ms_since(m_step_at) > kScriptTimeoutMs) {
+          std::fprintf(stderr, "pathtracer: %s:%d: '%s' timed out\n", m_options.script.c_str(), l.line, c.c_str());
+          m_exit = 1;
+          glfwSetWindowShouldClose(m_win, GLFW_TRUE);
+        }
+        return;
+      }
+      ++m_script_pos;
+      m_step_started = false;
+      if (c == "close" || c == "quit") return;
+    }
+  }
+
+  // Draws the current image and reads the framebuffer back (what the window shows).
+  void screenshot(const std::string& path) {
+    draw();
+    int fw, fh;
+    glfwGetFramebufferSize(m_win, &fw, &fh);
+    std::vector<uint8_t> rows(size_t(fw) * fh * 3), top_first(rows.size());
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_BACK);
+    glReadPixels(0, 0, fw, fh, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
+    size_t stride = size_t(fw) * 3;
+    for (int y = 0; y < fh; ++y)
+      std::copy(rows.begin() + (fh - 1 - y) * stride, rows.begin() + (fh - y) * stride, top_first.begin() + y * stride);
+    try {
+      write_png8(top_first, fw, fh, path);
+      say("screenshot: %s %dx%d", path.c_str(), fw, fh);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "pathtracer: screenshot: %s\n", e.what());
+      m_exit = 1;
+    }
+    m_dirty = true;
+  }
+
+  const CliOptions& m_options;
+  const SceneDesc& m_desc;
+  GLFWwindow* m_win;
+  Shared m_sh;
+  GLuint m_tex = 0;
+  int m_tex_w = 0, m_tex_h = 0;
+  uint64_t m_tex_gen = 0;
+  std::vector<uint8_t> m_rgb, m_rate;  // what the texture holds, for each view
+  bool m_show_rate = false, m_show_keys = false, m_dirty = true;
+  int m_resize_w = 0, m_resize_h = 0;
+  Clock::time_point m_resize_at;
+  std::string m_title;
+  std::vector<ScriptLine> m_script;
+  size_t m_script_pos = 0;
+  bool m_step_started = false;
+  Clock::time_point m_step_at;
+  int m_exit = 0;
+};
+
+std::string g_glfw_error;
+
+}  // namespace
+
+int run_viewer(const CliOptions& o) {
+  std::vector<ScriptLine> script;
+  try {
+    if (!o.script.empty()) script = load_script(o.script);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pathtracer: %s\n", e.what());
+    return 1;
+  }
+  glfwSetErrorCallback([](int, const char* text) { g_glfw_error = text; });
+  if (!glfwInit()) {
+    std::fprintf(stderr, "pathtracer: cannot open the debug window (%s); give -f FILE to render to a file\n",
+                 g_glfw_error.c_str());
+    return 2;
+  }
+  int rc;
+  try {
+    SceneDesc desc = load_collada(o.scene_path);
+    RenderParams p = o.params;
+    p.cell_w = p.cell_h = 0;
+    auto scene = make_render_scene(desc, p);
+    if (!o.quiet)
+      std::fprintf(stderr, "Loaded %s: %zu triangles, %zu spheres, %zu lights\n", o.scene_path.c_str(),
+                   scene->triangle_count, scene->sphere_count, scene->lights.size());
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
+    GLFWwindow* win = glfwCreateWindow(o.params.width, o.params.height, "pathtracer", nullptr, nullptr);
+    if (!win) {
+      std::fprintf(stderr, "pathtracer: cannot open the debug window (%s); give -f FILE to render to a file\n",
+                   g_glfw_error.c_str());
+      glfwTerminate();
+      return 2;
+    }
+    glfwMakeContextCurrent(win);
+    glfwSwapInterval(0);
+    {
+      Viewer viewer(o, desc, win, std::move(script));
+      rc = viewer.run(std::move(scene));
+    }
+    glfwDestroyWindow(win);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pathtracer: %s\n", e.what());
+    rc = 1;
+  }
+  glfwTerminate();
+  return rc;
+}
+
+}  // namespace pt
