@@ -70,6 +70,13 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     } else if (a == "-H") { p.hemisphere = true; }
     else if (a == "-h" || a == "--help") { o.help = true; }
     else if (a == "--no-adaptive") { p.adaptive = false; }
+    else if (a == "--keep-fov") { p.keep_fov = true; }
+    else if (a == "--generic") { p.generic = true; }
+    else if (a == "--describe") { o.describe = true; }
+    else if (a == "--error-log") { need(a, 1); o.error_log = args[++i]; }
+    else if (a == "--reference") { need(a, 1); o.reference = args[++i]; }
+    else if (a == "--target-error") { need(a, 1); o.limits.target_error = parse_float(a, args[++i], 0, 1e30); }
+    else if (a == "--time-limit") { need(a, 1); o.limits.time_limit = parse_float(a, args[++i], 0, 1e9); }
     else if (a == "--file-camera") { p.file_camera = true; }
     else if (a == "--seed") { need(a, 1); p.seed = uint64_t(parse_int(a, args[++i], 0, 0x7fffffffffffffffL)); }
     else if (a == "--tile") { need(a, 1); p.tile_size = int(parse_int(a, args[++i], 1, 4096)); }
@@ -122,6 +129,15 @@ std::string usage_text(const std::string& program) {
 "  --seed <INT>    random seed (default 0); the same seed gives the same image at any -t\n"
 "  --tile <INT>    tile size in pixels (default 32)\n"
 "  --quiet         no progress bar\n"
+"  --keep-fov      -r scales the course's 800x600 view to the output size instead of cropping it\n"
+"  --describe      print the scene's feature set and the memory it takes, then exit\n"
+"  --generic       run the path loop with every feature (for comparisons with the specialised one)\n"
+"\n"
+"Error against run time:\n"
+"  --error-log <FILE>     write one CSV row per pass: seconds, spp, error estimate (+ true error)\n"
+"  --target-error <X>     stop once the estimated relative MSE is <= X\n"
+"  --time-limit <SEC>     stop after SEC seconds of rendering\n"
+"  --reference <FILE>     a converged image of the same size: log its true RMSE and relative MSE\n"
 "  --script <FILE> window only: replay input from FILE, one command a line (for tests):\n"
 "                  wait_spp N | wait_ms N | key K | click X Y | resize W H | sync |\n"
 "                  title | screenshot FILE.png | close | quit\n"

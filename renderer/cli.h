@@ -16,6 +16,10 @@ struct CliOptions {
   bool help = false;
   bool quiet = false;      // --quiet: no progress bar
   std::string script;      // --script: window input replayed from a file (tests)
+  bool describe = false;   // --describe: print the feature set and memory, no render
+  std::string error_log;   // --error-log: CSV of the error per pass
+  std::string reference;   // --reference: true error against this image
+  RunLimits limits;        // --target-error, --time-limit
 };
 
 class UsageError : public std::runtime_error {

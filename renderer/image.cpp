@@ -19,6 +19,27 @@ uint8_t tonemap_course(float v) {
   return uint8_t(clampf(t, 0.0f, 1.0f) * 255.0f);
 }
 
+double relative_mse(const ImageRGB& img, const ImageRGB& ref) {
+  if (img.pixels.size() != ref.pixels.size() || img.pixels.empty()) return INFINITY;
+  double s = 0;
+  for (size_t i = 0; i < img.pixels.size(); ++i) {
+    double a = luminance(img.pixels[i]), b = luminance(ref.pixels[i]);
+    s += (a - b) * (a - b) / (b * b + kRelMseEpsilon);
+  }
+  return s / double(img.pixels.size());
+}
+
+double rmse(const ImageRGB& img, const ImageRGB& ref) {
+  if (img.pixels.size() != ref.pixels.size() || img.pixels.empty()) return INFINITY;
+  double s = 0;
+  for (size_t i = 0; i < img.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      double d = double(img.pixels[i][c]) - ref.pixels[i][c];
+      s += d * d;
+    }
+  return std::sqrt(s / (3.0 * img.pixels.size()));
+}
+
 std::vector<uint8_t> to_srgb8_course(const ImageRGB& img) {
   std::vector<uint8_t> out(img.pixels.size() * 3);
   for (size_t i = 0; i < img.pixels.size(); ++i)

@@ -18,6 +18,13 @@ struct ImageRGB {
 
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 
+// Relative MSE on luminance, mean of (a - ref)^2 / (ref^2 + eps): the error measure the renderer
+// estimates and the benchmarks report (eps keeps black pixels from dominating).
+constexpr double kRelMseEpsilon = 1e-2;
+double relative_mse(const ImageRGB& img, const ImageRGB& ref);
+// Root mean square error over all pixels and channels.
+double rmse(const ImageRGB& img, const ImageRGB& ref);
+
 // The course's look: clamp((sqrt(2) v)^(1/2.2), 0, 1) * 255, truncated.
 uint8_t tonemap_course(float v);
 std::vector<uint8_t> to_srgb8_course(const ImageRGB& img);

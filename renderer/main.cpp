@@ -11,6 +11,39 @@
 
 using namespace pt;
 
+namespace {
+
+// --describe: what the scene uses (and so which specialised path loop runs) and what it costs.
+int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene& scene, double load_s) {
+  const SceneFeatures& f = scene.features;
+  auto join = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
+    return s.empty() ? std::string("none") : s;
+  };
+  size_t bytes = scene.accel->memory_bytes();
+  size_t prims = desc.triangle_count() + desc.spheres.size();
+  std::printf("scene:            %s\n", o.scene_path.c_str());
+  std::printf("geometry:         %zu triangles in %zu meshes, %zu spheres\n", desc.triangle_count(), desc.meshes.size(),
+              desc.spheres.size());
+  std::printf("materials:        %s\n", join(f.materials).c_str());
+  std::printf("lights:           %s (%zu)\n", join(f.lights).c_str(), scene.lights.size());
+  std::printf("environment map:  %s\n", f.environment ? o.params.env_map.c_str() : "no");
+  std::printf("shading normals:  %s\n", f.shading_normals ? "yes (curved meshes)" : "no (flat shading)");
+  std::printf("camera:           %s\n", f.thin_lens ? "thin lens" : "pinhole");
+  std::printf("adaptive:         %s\n", f.adaptive ? "on" : "off (spp <= batch, or --no-adaptive)");
+  std::printf("path loop:        %s%s%s%s\n", f.bits == kFeatAll ? "generic" : "specialised:",
+              f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
+              f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),
+              f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
+  std::printf("render memory:    %.2f MiB (%.1f bytes per primitive: BVH, vertices, indices, shading data)\n",
+              bytes / 1048576.0, prims ? double(bytes) / prims : 0.0);
+  std::printf("load + build:     %.3f s\n", load_s);
+  return 0;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   CliOptions o;
@@ -24,7 +57,7 @@ int main(int argc, char** argv) {
     std::printf("%s", usage_text(argv[0]).c_str());
     return 0;
   }
-  if (o.output.empty()) return run_viewer(o);
+  if (o.output.empty() && !o.describe) return run_viewer(o);
   if (!o.script.empty()) {
     std::fprintf(stderr, "pathtracer: --script drives the window; it cannot be used with -f\n");
     return 1;
@@ -34,24 +67,52 @@ int main(int argc, char** argv) {
     SceneDesc desc = load_collada(o.scene_path);
     auto scene = make_render_scene(desc, o.params);
     double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (o.describe) return describe_scene(o, desc, *scene, load_s);
     if (!o.quiet)
       std::fprintf(stderr, "Loaded %s: %zu triangles, %zu spheres, %zu lights in %.3f s\n", o.scene_path.c_str(),
                    scene->triangle_count, scene->sphere_count, scene->lights.size(), load_s);
 
     RenderSession session(*scene, o.params);
+    ImageRGB reference;
+    if (!o.reference.empty()) {
+      reference = read_image(o.reference);
+      if (reference.width != session.width() || reference.height != session.height())
+        throw std::runtime_error(o.reference + ": the reference is " + std::to_string(reference.width) + "x" +
+                                 std::to_string(reference.height) + ", the render " + std::to_string(session.width()) +
+                                 "x" + std::to_string(session.height()));
+    }
+    FILE* log = nullptr;
+    if (!o.error_log.empty()) {
+      log = std::fopen(o.error_log.c_str(), "w");
+      if (!log) throw std::runtime_error(o.error_log + ": cannot write the error log");
+      std::fprintf(log, "seconds,spp,error_estimate%s\n", reference.pixels.empty() ? "" : ",rmse,rel_mse");
+    }
     ProgressBar bar("Rendering", !o.quiet);
-    session.render_all(nullptr, [&] { bar.update(session.progress()); });
+    double pixels = double(session.width()) * session.height();
+    auto on_pass = [&](const PassReport& r) {
+      if (!log) return;
+      std::fprintf(log, "%.6f,%.4f,%.6g", r.seconds, session.stats().samples / pixels, r.error);
+      if (!reference.pixels.empty()) {
+        ImageRGB img = session.image();
+        std::fprintf(log, ",%.6g,%.6g", rmse(img, reference), relative_mse(img, reference));
+      }
+      std::fprintf(log, "\n");
+      std::fflush(log);
+    };
+    StopReason why = run_progressive(session, o.limits, nullptr, [&](const Tile&) { bar.update(session.progress()); }, on_pass);
     bar.finish();
+    if (log) std::fclose(log);
 
     Metadata meta = render_metadata(o, session);
+    meta.push_back({"pathtracer:stopped", stop_reason_name(why)});
     write_image(session.image(), o.output, meta);
     write_image(session.rate_image(), rate_image_path(o.output));
 
     SessionStats st = session.stats();
-    double pixels = double(session.width()) * session.height();
-    std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %.3g%s\n",
+    std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %.3g%s%s\n",
                 o.output.c_str(), session.width(), session.height(), st.samples / pixels, o.params.spp, st.seconds,
                 st.samples / st.seconds, st.rays / st.seconds, session.error_estimate(),
+                why == StopReason::finished ? "" : (std::string(", ") + stop_reason_name(why)).c_str(),
                 st.nonfinite ? (", " + std::to_string(st.nonfinite) + " non-finite samples dropped").c_str() : "");
     return 0;
   } catch (const std::exception& e) {

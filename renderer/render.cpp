@@ -220,7 +220,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
   const PathTracer trace = path_tracer_for(m_scene.features.bits);
   const int batch = std::max(1, p.adaptive_batch);
   for (int y = t.y0; y < t.y1; ++y) {
-    if (cancel && cancel->load(std::memory_order_relaxed)) return;
+    if (stop_requested(cancel)) return;
     for (int x = t.x0; x < t.x1; ++x) {
       size_t i = size_t(y) * m_w + x;
       if (m_done[i]) continue;
@@ -230,7 +230,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
       uint32_t before = m_count[i];
       while (m_count[i] < uint32_t(target)) {
         uint32_t s = m_count[i];
-        if ((s & 15) == 15 && cancel && cancel->load(std::memory_order_relaxed)) break;
+        if ((s & 15) == 15 && stop_requested(cancel)) break;
         Pcg32 rng = make_sample_rng(p.seed, pixel_index, s);
         Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
         Vec2 lens = rng.next_2d();
@@ -273,9 +273,9 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
     for (;;) {
       size_t ti = next.fetch_add(1);
       if (ti >= m_tiles.size()) break;
-      if (cancel && cancel->load()) break;
+      if (stop_requested(cancel)) break;
       render_tile(m_tiles[ti], target_spp, cancel, rays, samples, nonfinite);
-      if (on_tile && !(cancel && cancel->load())) on_tile(m_tiles[ti]);
+      if (on_tile && !stop_requested(cancel)) on_tile(m_tiles[ti]);
     }
     m_rays += rays;
     m_samples += samples;
@@ -288,18 +288,49 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
   for (auto& t : pool) t.join();
   m_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++m_passes;
-  return !(cancel && cancel->load());
+  return !stop_requested(cancel);
 }
 
 bool RenderSession::render_all(const std::atomic<bool>* cancel, const std::function<void()>& on_progress) {
-  int target = 1;
-  while (!finished()) {
-    if (!render_pass(target, cancel, on_progress ? TileCallback([&](const Tile&) { on_progress(); }) : TileCallback()))
-      return false;
-    if (target >= m_params.spp) break;
-    target = std::min(m_params.spp, target * 2);
+  TileCallback tiles = on_progress ? TileCallback([&](const Tile&) { on_progress(); }) : TileCallback();
+  return run_progressive(*this, RunLimits(), cancel, tiles) == StopReason::finished;
+}
+
+const char* stop_reason_name(StopReason r) {
+  switch (r) {
+    case StopReason::finished: return "finished";
+    case StopReason::target_error: return "error target reached";
+    case StopReason::time_limit: return "time limit reached";
+    case StopReason::cancelled: return "cancelled";
   }
-  return true;
+  return "?";
+}
+
+StopReason run_progressive(RenderSession& s, const RunLimits& limits, const std::atomic<bool>* cancel,
+                           const RenderSession::TileCallback& on_tile,
+                           const std::function<void(const PassReport&)>& on_pass) {
+  auto start = std::chrono::steady_clock::now();
+  if (limits.time_limit > 0)
+    s.set_deadline(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                               std::chrono::duration<double>(limits.time_limit)));
+  const int spp = s.params().spp;
+  StopReason reason = StopReason::finished;
+  for (int target = 1;; target = std::min(spp, target * 2)) {
+    bool completed = s.render_pass(target, cancel, on_tile);
+    double err = s.error_estimate();
+    if (on_pass) on_pass({target, s.stats().seconds, err});
+    if (!completed) {
+      reason = (cancel && cancel->load()) ? StopReason::cancelled : StopReason::time_limit;
+      break;
+    }
+    if (limits.target_error > 0 && err <= limits.target_error) {
+      reason = StopReason::target_error;
+      break;
+    }
+    if (s.finished() || target >= spp) break;
+  }
+  s.set_deadline(std::chrono::steady_clock::time_point::max());
+  return reason;
 }
 
 bool RenderSession::finished() const {
@@ -369,7 +400,7 @@ double RenderSession::error_estimate() const {
     if (c < 2) continue;
     double mu = m_s1[i] / c;
     double var = std::max(0.0, (m_s2[i] - m_s1[i] * m_s1[i] / c) / (c - 1));
-    sum += (var / c) / (mu * mu + 1e-2);
+    sum += (var / c) / (mu * mu + kRelMseEpsilon);
     ++n;
   }
   return n ? sum / double(m_count.size()) : INFINITY;

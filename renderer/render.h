@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -103,9 +104,12 @@ class RenderSession {
   // `on_tile` runs on worker threads after each finished tile. Returns false if cancelled.
   using TileCallback = std::function<void(const Tile&)>;
   bool render_pass(int target_spp, const std::atomic<bool>* cancel = nullptr, const TileCallback& on_tile = {});
+  // Passes also stop (as if cancelled) once this steady-clock time has passed.
+  void set_deadline(std::chrono::steady_clock::time_point t) { m_deadline = t; }
   // Renders passes of doubling size up to params.spp; `on_pass` after each pass.
   bool render_all(const std::atomic<bool>* cancel = nullptr, const std::function<void()>& on_progress = {});
 
+  const RenderParams& params() const { return m_params; }
   int width() const { return m_w; }
   int height() const { return m_h; }
   bool finished() const;
@@ -140,6 +144,29 @@ class RenderSession {
   std::atomic<uint64_t> m_budget_done{0};  // pixel-samples done, converged pixels counted in full
   double m_seconds = 0;
   int m_passes = 0;
+  std::chrono::steady_clock::time_point m_deadline = std::chrono::steady_clock::time_point::max();
+  bool stop_requested(const std::atomic<bool>* cancel) const {
+    return (cancel && cancel->load(std::memory_order_relaxed)) || std::chrono::steady_clock::now() >= m_deadline;
+  }
 };
+
+// Halting conditions shared by the CLI, the server and the window.
+struct RunLimits {
+  double time_limit = 0;     // seconds of rendering; 0 = none
+  double target_error = 0;   // stop once error_estimate() <= this; 0 = none
+};
+enum class StopReason { finished, target_error, time_limit, cancelled };
+const char* stop_reason_name(StopReason r);
+struct PassReport {
+  int target_spp;   // samples per pixel this pass aimed for
+  double seconds;   // rendering time so far
+  double error;     // error_estimate() after the pass
+};
+// The progressive driver: passes of doubling sample counts (1, 2, 4, ... spp) until every pixel
+// is done, the error target or time limit is reached, or `cancel` is set. `on_pass` runs after
+// each pass (also the last, partial one).
+StopReason run_progressive(RenderSession& session, const RunLimits& limits, const std::atomic<bool>* cancel = nullptr,
+                           const RenderSession::TileCallback& on_tile = {},
+                           const std::function<void(const PassReport&)>& on_pass = {});
 
 }  // namespace pt

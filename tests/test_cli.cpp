@@ -185,3 +185,42 @@ TEST(Cli, MoreThreadsThanCoresStillWork) {
   RunResult r = run("-t 64 -s 2 -r 40 30 --quiet -f " + test::temp_dir() + "/many.png " + scene);
   EXPECT_EQ(r.status, 0) << r.output;
 }
+
+TEST(Cli, DescribePrintsTheFeatureSetAndMemory) {
+  RunResult r = run("--describe " + test::own_scene("cornell.dae"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("materials:        diffuse, emission, glass, mirror"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("lights:           area"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("specialised: delta no-microfacet no-infinite-lights"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bytes per primitive"), std::string::npos) << r.output;
+  r = run("--describe --generic " + test::own_scene("cornell.dae"));
+  EXPECT_NE(r.output.find("path loop:        generic"), std::string::npos) << r.output;
+}
+
+TEST(Cli, ErrorLogTargetErrorAndReference) {
+  std::string dir = test::temp_dir(), scene = test::own_scene("dof.dae");
+  // A converged reference, then a run that logs its true error against it.
+  RunResult r = run("-t 2 -s 256 -m 2 -r 40 30 --keep-fov --no-adaptive --seed 7 --quiet -f " + dir + "/ref.exr " + scene);
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = run("-t 2 -s 32 -m 2 -r 40 30 --keep-fov --no-adaptive --quiet --error-log " + dir + "/log.csv --reference " + dir +
+          "/ref.exr -f " + dir + "/run.png " + scene);
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream in(dir + "/log.csv");
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header, "seconds,spp,error_estimate,rmse,rel_mse");
+  std::vector<double> rel;
+  while (std::getline(in, line)) rel.push_back(std::stod(line.substr(line.find_last_of(',') + 1)));
+  ASSERT_EQ(rel.size(), 6u);  // passes of 1, 2, 4, 8, 16, 32 spp
+  EXPECT_LT(rel.back(), rel.front() / 8);  // the true error falls as samples accumulate
+
+  // The error target stops the render before its sample budget.
+  r = run("-t 2 -s 4096 -m 2 -r 40 30 --no-adaptive --quiet --target-error 0.02 -f " + dir + "/target.png " + scene);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("error target reached"), std::string::npos) << r.output;
+
+  // A reference of the wrong size is refused by name.
+  r = run("-s 2 -r 20 10 --quiet --reference " + dir + "/ref.exr -f " + dir + "/bad.png " + scene);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("ref.exr"), std::string::npos) << r.output;
+}
