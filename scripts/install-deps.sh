@@ -6,9 +6,13 @@ packages=(
   libembree-dev libopenimageio-dev openimageio-tools libpugixml-dev libtbb-dev
   libgtest-dev libcpp-httplib-dev nlohmann-json3-dev libglfw3-dev xvfb
   libgl1-mesa-dri xauth  # the window tests: Mesa's llvmpipe OpenGL under Xvfb
+  chromium nodejs npm  # the web page's browser test (tests/web: playwright-core drives this Chromium)
+  python3-venv python3-pip  # build/venv for the server tests (scripts/python-env.sh)
 )
 missing=()
 for p in "${packages[@]}"; do
+  # A nodejs that bundles npm (NodeSource's) conflicts with Debian's npm package: keep it.
+  if [ "$p" = npm ] && command -v npm >/dev/null 2>&1; then continue; fi
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -eq 0 ]; then

@@ -4,5 +4,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
+# The browser test's Node packages (tests/web), installed only when missing or older than the lock file.
+if [ ! -f tests/web/node_modules/.package-lock.json ] ||
+   [ tests/web/package-lock.json -nt tests/web/node_modules/.package-lock.json ]; then
+  (cd tests/web && npm ci --no-audit --no-fund)
+fi
+bash scripts/python-env.sh  # build/venv: pytest, requests, jsonschema, schemathesis for tests/server
 cd build
 ctest --output-on-failure --timeout 900 -j "$(nproc)"

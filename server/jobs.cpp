@@ -242,8 +242,9 @@ json JobManager::status_json(const Job& j, bool with_history) const {
 
 double JobManager::focus_distance(const Job& job, double x, double y) {
   pt::RenderParams p = job.spec.params;
-  if (!(x >= 0 && y >= 0 && x <= p.width && y <= p.height))
-    throw ApiError(400, "x and y must lie inside the " + std::to_string(p.width) + "x" + std::to_string(p.height) + " image", "x");
+  std::string size = std::to_string(p.width) + "x" + std::to_string(p.height);
+  if (!(x >= 0 && x <= p.width)) throw ApiError(400, "x must lie inside the " + size + " image", "x");
+  if (!(y >= 0 && y <= p.height)) throw ApiError(400, "y must lie inside the " + size + " image", "y");
   auto desc = m_scenes.load(job.spec.scene);
   p.env_map.clear();
   auto scene = pt::make_render_scene(*desc, p);
@@ -413,9 +414,10 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
     };
 
     int target = 1;
+    bool completed = true;
     auto last_persist = clock::now();
     for (;;) {
-      bool completed = session.render_pass(target, &stop, on_tile);
+      completed = session.render_pass(target, &stop, on_tile);
       pt::SessionStats st = session.stats();
       double err = session.error_estimate();
       {
@@ -466,6 +468,10 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
       notify();
       return;
     }
+    // The time limit cut a pass short: its unfinished tiles never reached on_tile, so publish every
+    // tile once more and the event stream ends on the same picture as image.png.
+    if (!completed)
+      for (const pt::Tile& t : session.tiles()) on_tile(t);
     // Finished (sample budget, error target or time limit): images first, then the state.
     pt::ImageRGB img = session.image();
     pt::Metadata meta{{"pathtracer:scene", job->spec.scene},

@@ -2,10 +2,12 @@
 // stream (Server-Sent Events) with per-client tile bookkeeping so slow clients skip ahead.
 #include "routes.h"
 
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "image.h"
@@ -16,7 +18,8 @@ namespace {
 
 void send_json(httplib::Response& res, int status, const json& body) {
   res.status = status;
-  res.set_content(body.dump(), "application/json");
+  // replace: a message quoting a non-UTF-8 path (GET /api/%FF) must not throw.
+  res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
 }
 
 void send_error(httplib::Response& res, int status, const std::string& message, const std::string& field = "") {
@@ -62,14 +65,29 @@ bool read_file(const std::string& path, std::string& out) {
 }
 
 json parse_body(const httplib::Request& req) {
-  const std::string& ct = req.get_header_value("Content-Type");
+  std::string ct = req.get_header_value("Content-Type");
+  for (char& c : ct) c = char(std::tolower((unsigned char)c));  // media types are case-insensitive
   if (!ct.empty() && ct.find("application/json") == std::string::npos)
     throw ApiError(415, "Content-Type must be application/json");
   try {
     return json::parse(req.body);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e400
     throw ApiError(400, std::string("malformed JSON: ") + e.what());
   }
+}
+
+// The methods each API path answers (keep in step with install_routes): a known path asked with
+// another method gets 405 and an Allow header instead of 404.
+std::string allowed_methods(const std::string& path) {
+  static const std::pair<std::regex, const char*> table[] = {
+      {std::regex("/api/(health|openapi\\.json|scenes)"), "GET"},
+      {std::regex("/api/jobs"), "GET, POST"},
+      {std::regex("/api/jobs/check"), "POST"},
+      {std::regex("/api/jobs/[^/]+"), "GET, DELETE"},
+      {std::regex("/api/jobs/[^/]+/(image\\.png|image\\.exr|focus|events)"), "GET"}};
+  for (const auto& [re, allow] : table)
+    if (std::regex_match(path, re)) return allow;
+  return "";
 }
 
 // Runs a handler body, turning ApiError into its JSON error and anything else into a 500.
@@ -128,7 +146,7 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
   for (;;) {
     json status;
     uint64_t version;
-    bool final_state, has_image;
+    bool final_state, has_image, png_on_disk = false;
     std::vector<uint8_t> display;
     int width = 0, height = 0;
     {
@@ -150,17 +168,20 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
       final_state = is_final(job->state);
       has_image = job->has_image;
       if (sent.size() != job->tile_version.size()) sent.assign(job->tile_version.size(), 0);
-      if (first && has_image) {
-        display = job->display;
+      if (first && (has_image || job->state == JobState::done)) {
+        display = job->display;  // empty for a job finished before a restart: its PNG is on disk
+        png_on_disk = !has_image;
         width = job->width;
         height = job->height;
       }
     }
     if (first) {
       // A late or reconnecting client starts from the current picture.
-      if (!display.empty()) {
-        if (!write(sse("image", {{"width", width}, {"height", height}, {"png", base64(pt::encode_png8(display, width, height))}}, version)))
-          return;
+      std::string png;
+      if (png_on_disk) read_file(jobs.job_dir(job->id) + "/image.png", png);
+      else if (!display.empty()) png = pt::encode_png8(display, width, height);
+      if (!png.empty()) {
+        if (!write(sse("image", {{"width", width}, {"height", height}, {"png", base64(png)}}, version))) return;
         std::lock_guard<std::mutex> lock(job->mutex);
         for (size_t i = 0; i < sent.size() && i < job->tile_version.size(); ++i) sent[i] = std::min(job->tile_version[i], version);
       }
@@ -178,7 +199,8 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
       int x, y, w, h;
       uint64_t v;
       if (!tile_png(*job, i, png, x, y, w, h, v)) continue;
-      if (!write(sse("tile", {{"x", x}, {"y", y}, {"w", w}, {"h", h}, {"png", base64(png)}}, v))) return;
+      // The id is this round's version, not the tile's: ids never go back within a stream.
+      if (!write(sse("tile", {{"x", x}, {"y", y}, {"w", w}, {"h", h}, {"png", base64(png)}}, version))) return;
       sent[i] = v;
     }
     seen = version;
@@ -192,6 +214,16 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
 }  // namespace
 
 void install_routes(httplib::Server& svr, JobManager& jobs, const std::string& openapi) {
+  // httplib 0.11 reads a request body without Content-Length until the read timeout (10 s, then
+  // 400): refuse such a request at once.
+  svr.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
+    bool body_method = req.method == "POST" || req.method == "PUT" || req.method == "PATCH";
+    if (!body_method || req.has_header("Content-Length") || req.has_header("Transfer-Encoding"))
+      return httplib::Server::HandlerResponse::Unhandled;
+    send_error(res, 411, "Content-Length is required");
+    return httplib::Server::HandlerResponse::Handled;
+  });
+
   svr.Get("/api/health", [&](const httplib::Request&, httplib::Response& res) {
     size_t queued = 0, running = 0;
     for (auto& j : jobs.list()) {
@@ -279,7 +311,7 @@ void install_routes(httplib::Server& svr, JobManager& jobs, const std::string& o
             return;
           }
           img.pixels.resize(size_t(img.width) * img.height);
-          std::memcpy(img.pixels.data(), job->linear.data(), img.pixels.size() * sizeof(pt::Vec3));
+          std::memcpy(static_cast<void*>(img.pixels.data()), job->linear.data(), img.pixels.size() * sizeof(pt::Vec3));
         }
       }
       if (data.empty()) data = pt::encode_exr(img);
@@ -321,6 +353,11 @@ void install_routes(httplib::Server& svr, JobManager& jobs, const std::string& o
 
   svr.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;  // a handler already wrote its JSON error
+    std::string allow = res.status == 404 ? allowed_methods(req.path) : "";
+    if (!allow.empty()) {
+      res.set_header("Allow", allow);
+      return send_error(res, 405, req.method + " is not allowed on " + req.path + " (allowed: " + allow + ")");
+    }
     if (req.path.rfind("/api/", 0) == 0 || res.status != 404)
       send_error(res, res.status, res.status == 404 ? "no such endpoint: " + req.method + " " + req.path
                                                     : "request rejected (" + std::to_string(res.status) + ")");

@@ -1,0 +1,496 @@
+"""What the render-server tests share: the paths ctest passes in, a real server process on a
+loopback port, an HTTP client that checks every JSON answer against server/openapi.json, an
+event-stream reader, and small PNG / OpenEXR decoders (no image library in the venv)."""
+import base64
+import copy
+import http.client
+import json
+import os
+import re
+import select
+import signal
+import socket
+import struct
+import subprocess
+import time
+import zlib
+from pathlib import Path
+
+import requests
+from jsonschema import Draft4Validator
+from referencing import Registry, Resource
+from referencing.jsonschema import DRAFT4
+
+# ---- paths (ctest sets them; the fallbacks serve a run by hand from the source tree) ----
+SOURCE_DIR = Path(os.environ.get("PT_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+RENDER_SERVER = Path(os.environ.get("PT_RENDER_SERVER", SOURCE_DIR / "build/render-server"))
+PATHTRACER = Path(os.environ.get("PT_PATHTRACER", SOURCE_DIR / "build/pathtracer"))
+SHARED_SCENES = Path(os.environ.get("PT_SHARED_SCENES", SOURCE_DIR.parent / "shared/scenes-cs184"))
+OPENAPI_FILE = SOURCE_DIR / "server/openapi.json"
+CORNELL = SOURCE_DIR / "scenes/cornell.dae"
+
+# A render that finishes in a few milliseconds and one that runs until cancelled (or time_limit).
+TINY = {"scene": "cornell", "width": 64, "height": 48, "spp": 4, "max_depth": 3, "seed": 1}
+ENDLESS = {"scene": "cornell", "width": 160, "height": 120, "spp": 65536, "adaptive": False, "max_depth": 5}
+
+
+# ---- the contract: server/openapi.json as JSON Schema (draft 4, which OpenAPI 3.0 extends) ----
+class Contract:
+    URN = "urn:render-server-openapi"
+
+    def __init__(self, doc):
+        self.doc = doc
+        root = self._to_json_schema(copy.deepcopy(doc))
+        self.registry = Registry().with_resource(self.URN, Resource.from_contents(root, default_specification=DRAFT4))
+        self.root = root
+        self._validators = {}
+
+    @classmethod
+    def load(cls):
+        return cls(json.loads(OPENAPI_FILE.read_text()))
+
+    def _to_json_schema(self, node):
+        # nullable: true -> a type list with "null"; local refs -> refs into the registered document.
+        if isinstance(node, dict):
+            if node.get("nullable") is True and "type" in node:
+                node["type"] = [node["type"], "null"]
+                if "enum" in node:
+                    node["enum"] = node["enum"] + [None]
+            if isinstance(node.get("$ref"), str) and node["$ref"].startswith("#/"):
+                node["$ref"] = self.URN + node["$ref"]
+            for v in node.values():
+                self._to_json_schema(v)
+        elif isinstance(node, list):
+            for v in node:
+                self._to_json_schema(v)
+        return node
+
+    def validator(self, schema):
+        key = json.dumps(schema, sort_keys=True)
+        if key not in self._validators:
+            self._validators[key] = Draft4Validator(schema, registry=self.registry)
+        return self._validators[key]
+
+    def component(self, name):
+        return {"$ref": f"{self.URN}#/components/schemas/{name}"}
+
+    def validate(self, instance, schema, what):
+        errors = sorted(self.validator(schema).iter_errors(instance), key=lambda e: list(e.path))
+        assert not errors, f"{what} breaks the contract: " + "; ".join(
+            f"{'/'.join(map(str, e.path)) or '(root)'}: {e.message}" for e in errors[:5])
+
+    def validate_component(self, instance, name, what=None):
+        self.validate(instance, self.component(name), what or name)
+
+    def operation(self, method, path):
+        """The documented operation for a request path (no query), or (None, None)."""
+        method = method.lower()
+        paths = self.root["paths"]
+        for tmpl in sorted(paths, key=lambda t: "{" in t):  # literal paths before templates
+            regex = "^" + re.sub(r"\\\{[a-z_]+\\\}", "[^/]+", re.escape(tmpl)) + "$"
+            if re.match(regex, path) and method in paths[tmpl]:
+                return tmpl, paths[tmpl][method]
+        return None, None
+
+    def check_response(self, method, path, resp):
+        """Asserts that an answer is documented: status, content type, headers and JSON body."""
+        path = path.split("?", 1)[0]
+        what = f"{method} {path} -> {resp.status_code}"
+        media = resp.headers.get("Content-Type", "").split(";")[0].strip()
+        tmpl, op = self.operation(method, path)
+        if op is None:  # no such endpoint, or a method the path does not take
+            if not path.startswith("/api/"):
+                return
+            assert resp.status_code in (400, 404, 405, 411, 413, 414), what
+            assert media == "application/json", f"{what}: Content-Type {media!r}"
+        else:
+            documented = op["responses"]
+            assert str(resp.status_code) in documented, f"{what}: status not documented for {tmpl}"
+            spec = documented[str(resp.status_code)]
+            if method.upper() != "HEAD":
+                assert media in spec.get("content", {}), f"{what}: Content-Type {media!r} not documented"
+            for header in spec.get("headers", {}):
+                assert header in resp.headers, f"{what}: missing header {header}"
+            if media != "application/json":
+                return
+        body = resp.json()
+        if op is None or resp.status_code >= 400:
+            self.validate_component(body, "Error", what)
+            assert body["error"]["status"] == resp.status_code, what
+        else:
+            self.validate(body, documented[str(resp.status_code)]["content"]["application/json"]["schema"], what)
+
+
+# ---- the HTTP client: every answer goes through the contract ----
+class Api:
+    def __init__(self, base, contract):
+        self.base = base
+        self.contract = contract
+        self.session = requests.Session()
+
+    def request(self, method, path, expect=None, timeout=15, **kw):
+        resp = self.session.request(method, self.base + path, timeout=timeout, **kw)
+        self.contract.check_response(method, path, resp)
+        if expect is not None:
+            assert resp.status_code == expect, f"{method} {path}: {resp.status_code} {resp.text[:400]}"
+        return resp
+
+    def get(self, path, expect=200, **kw):
+        return self.request("GET", path, expect, **kw)
+
+    def post(self, path, body=None, expect=None, headers=None, **kw):
+        return self.request("POST", path, expect, json=body, headers=headers, **kw)
+
+    def delete(self, path, expect=None, **kw):
+        return self.request("DELETE", path, expect, **kw)
+
+    def submit(self, spec, expect=201, key=None):
+        headers = {"Idempotency-Key": key} if key is not None else None
+        return self.post("/api/jobs", spec, expect=expect, headers=headers).json()
+
+    def job(self, job_id):
+        return self.get(f"/api/jobs/{job_id}").json()
+
+    def wait(self, job_id, states, timeout=30, samples=0, poll=0.02):
+        """Polls until the job is in one of `states` (and has taken at least `samples` samples)."""
+        states = {states} if isinstance(states, str) else set(states)
+        deadline = time.monotonic() + timeout
+        while True:
+            job = self.job(job_id)
+            if job["state"] in states and job["samples"] >= samples:
+                return job
+            assert time.monotonic() < deadline, f"job {job_id} still {job['state']} ({job['samples']} samples)"
+            time.sleep(poll)
+
+    def error(self, resp, status, field=None):
+        """Asserts an error answer: exact status, JSON shape, and the field it names (or none)."""
+        assert resp.status_code == status, f"expected {status}, got {resp.status_code}: {resp.text[:400]}"
+        err = resp.json()["error"]
+        assert err["status"] == status and err["message"]
+        assert err.get("field") == field, f"field {err.get('field')!r}, expected {field!r}: {err['message']}"
+        return err
+
+
+# ---- a real server process ----
+class Server:
+    def __init__(self, root, contract, threads=1, args=(), scenes=None):
+        self.root = Path(root)
+        self.data = self.root / "data"
+        self.scenes = Path(scenes) if scenes else self.root / "scenes"
+        self.contract = contract
+        self.threads = threads
+        self.args = list(args)
+        self.proc = None
+        if not scenes and not self.scenes.exists():
+            self.scenes.mkdir(parents=True)
+            (self.scenes / "cornell.dae").write_bytes(CORNELL.read_bytes())
+
+    def start(self, timeout=15):
+        cmd = [str(RENDER_SERVER), "--port", "0", "--data", str(self.data), "--scenes", str(self.scenes),
+               "--threads", str(self.threads), *self.args]
+        self.log_path = self.root / f"server-{len(list(self.root.glob('server-*.log'))) + 1}.log"
+        self.log = open(self.log_path, "wb")
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, cwd=self.root)
+        line = b""
+        deadline = time.monotonic() + timeout
+        while not line.endswith(b"\n"):
+            left = deadline - time.monotonic()
+            assert left > 0 and self.proc.poll() is None, f"server did not start: {self.log_text()}"
+            if select.select([self.proc.stdout], [], [], left)[0]:
+                chunk = os.read(self.proc.stdout.fileno(), 1)
+                assert chunk, f"server exited: {self.log_text()}"
+                line += chunk
+        m = re.fullmatch(rb"render-server: listening on http://127\.0\.0\.1:(\d+)/\n", line)
+        assert m, f"unexpected first line {line!r}"
+        self.port = int(m[1])
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.api = Api(self.url, self.contract)
+        return self
+
+    def log_text(self):
+        try:
+            return self.log_path.read_text(errors="replace")
+        except OSError:
+            return ""
+
+    def alive(self):
+        return self.proc is not None and self.proc.poll() is None
+
+    def terminate(self, timeout=20):
+        """SIGTERM; returns the exit code."""
+        self.proc.send_signal(signal.SIGTERM)
+        return self.proc.wait(timeout)
+
+    def kill(self):
+        if self.alive():
+            self.proc.kill()
+        if self.proc is not None:
+            self.proc.wait(10)
+            self.log.close()
+
+    def events(self, job_id, **kw):
+        return EventStream(self.port, job_id, self.contract, **kw)
+
+
+# ---- Server-Sent Events ----
+class Event:
+    def __init__(self, kind, data, event_id):
+        self.kind, self.data, self.id = kind, data, event_id
+
+    def __repr__(self):
+        return f"Event({self.kind}, id={self.id})"
+
+
+EVENT_SCHEMAS = {"image": "ImageEvent", "status": "StatusEvent", "tile": "TileEvent", "end": "EndEvent"}
+
+
+class EventStream:
+    """One watcher of /api/jobs/{id}/events; every event's data is checked against its schema."""
+
+    def __init__(self, port, job_id, contract, last_event_id=None, timeout=15):
+        self.contract = contract
+        self.conn = http.client.HTTPConnection("127.0.0.1", port, timeout=timeout)
+        headers = {"Accept": "text/event-stream"}
+        if last_event_id is not None:
+            headers["Last-Event-ID"] = str(last_event_id)
+        self.conn.request("GET", f"/api/jobs/{job_id}/events", headers=headers)
+        self.resp = self.conn.getresponse()
+        self.status = self.resp.status
+        self.content_type = self.resp.getheader("Content-Type", "")
+        self.ended = False
+        self.retry = None
+
+    def next(self):
+        """The next event, or None when the server closed the stream."""
+        kind, data, event_id = "message", [], None
+        while True:
+            line = self.resp.readline()
+            if not line:
+                self.ended = True
+                return None
+            line = line.decode().rstrip("\r\n")
+            if line == "":
+                if not data:
+                    continue
+                payload = json.loads("\n".join(data))
+                assert kind in EVENT_SCHEMAS, f"unknown event type {kind!r}"
+                self.contract.validate_component(payload, EVENT_SCHEMAS[kind], f"{kind} event")
+                return Event(kind, payload, int(event_id) if event_id is not None else None)
+            if line.startswith(":"):
+                continue
+            name, _, value = line.partition(":")
+            value = value[1:] if value.startswith(" ") else value
+            if name == "event":
+                kind = value
+            elif name == "data":
+                data.append(value)
+            elif name == "id":
+                event_id = value
+            elif name == "retry":
+                self.retry = int(value)
+
+    def __iter__(self):
+        while (ev := self.next()) is not None:
+            yield ev
+
+    def until_end(self):
+        """Every remaining event; asserts the stream ends with (only) an end event."""
+        events = list(self)
+        assert events and events[-1].kind == "end", f"stream closed without an end event: {events[-3:]}"
+        assert all(e.kind != "end" for e in events[:-1])
+        return events
+
+    def close(self):
+        self.conn.close()
+
+
+# ---- images ----
+def decode_png(data):
+    """8-bit PNG -> (width, height, RGB bytes). Handles every filter; no interlacing."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    pos, idat, ihdr = 8, b"", None
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+        if kind == b"IHDR":
+            ihdr = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat += body
+        elif kind == b"IEND":
+            break
+    width, height, depth, color, _, _, interlace = ihdr
+    assert depth == 8 and interlace == 0, ihdr
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}[color]
+    raw = zlib.decompress(idat)
+    stride = width * channels
+    rows, prev = [], bytearray(stride)
+    for y in range(height):
+        f = raw[y * (stride + 1)]
+        line = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - channels] if i >= channels else 0
+            b = prev[i]
+            c = prev[i - channels] if i >= channels else 0
+            if f == 1:
+                line[i] = (line[i] + a) & 255
+            elif f == 2:
+                line[i] = (line[i] + b) & 255
+            elif f == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(bytes(line))
+        prev = line
+    pixels = b"".join(rows)
+    if channels != 3:  # to RGB
+        out = bytearray()
+        for i in range(0, len(pixels), channels):
+            px = pixels[i:i + channels]
+            out += bytes(px[:1] * 3) if channels <= 2 else bytes(px[:3])
+        pixels = bytes(out)
+    return width, height, pixels
+
+
+def read_exr(data):
+    """Scanline OpenEXR (NONE / ZIPS / ZIP, HALF or FLOAT channels) -> (width, height,
+    {channel: [floats]}, {attribute: value}); string attributes decoded, others raw bytes."""
+    assert data[:4] == b"\x76\x2f\x31\x01", "not an OpenEXR file"
+    assert not struct.unpack("<I", data[4:8])[0] & 0x200, "tiled EXR not supported"
+    pos, attrs = 8, {}
+    while data[pos] != 0:
+        end = data.index(b"\0", pos)
+        name = data[pos:end].decode()
+        tend = data.index(b"\0", end + 1)
+        kind = data[end + 1:tend].decode()
+        size = struct.unpack("<i", data[tend + 1:tend + 5])[0]
+        value = data[tend + 5:tend + 5 + size]
+        attrs[name] = value.decode(errors="replace") if kind == "string" else (kind, value)
+        pos = tend + 5 + size
+    pos += 1
+    channels, chl = [], attrs["channels"][1]
+    p = 0
+    while chl[p] != 0:
+        end = chl.index(b"\0", p)
+        ptype = struct.unpack("<i", chl[end + 1:end + 5])[0]
+        channels.append((chl[p:end].decode(), ptype))
+        p = end + 17
+    compression = attrs["compression"][1][0]
+    xmin, ymin, xmax, ymax = struct.unpack("<4i", attrs["dataWindow"][1])
+    width, height = xmax - xmin + 1, ymax - ymin + 1
+    lines = {0: 1, 2: 1, 3: 16}[compression]
+    nblocks = (height + lines - 1) // lines
+    offsets = struct.unpack(f"<{nblocks}Q", data[pos:pos + 8 * nblocks])
+    out = {name: [0.0] * (width * height) for name, _ in channels}
+    for off in offsets:
+        y, size = struct.unpack("<ii", data[off:off + 8])
+        block = data[off + 8:off + 8 + size]
+        nlines = min(lines, ymax + 1 - y)
+        expected = sum(width * (2 if t == 1 else 4) for _, t in channels) * nlines
+        if compression != 0 and size < expected:
+            t = bytearray(zlib.decompress(block))
+            for i in range(1, len(t)):  # undo the predictor, then the byte interleave
+                t[i] = (t[i - 1] + t[i] - 128) & 255
+            half = (len(t) + 1) // 2
+            block = bytearray(len(t))
+            block[0::2] = t[:half]
+            block[1::2] = t[half:]
+        q = 0
+        for row in range(nlines):
+            for name, ptype in channels:
+                fmt, step = ("<e", 2) if ptype == 1 else ("<f", 4)
+                vals = struct.unpack(f"<{width}{fmt[1]}", bytes(block[q:q + width * step]))
+                q += width * step
+                base = (y - ymin + row) * width
+                out[name][base:base + width] = vals
+    return width, height, out, attrs
+
+
+def tonemap_course(v):
+    """The renderer's 8-bit tone mapping (renderer/image.cpp), for cross-checking decoders."""
+    if not v > 0:
+        return 0
+    t = (1.41421356 * v) ** (1 / 2.2)
+    return int(min(max(t, 0.0), 1.0) * 255.0)
+
+
+class Canvas:
+    """An RGB image painted from the event stream's image and tile events."""
+
+    def __init__(self, width, height, tile_size):
+        self.width, self.height, self.tile_size = width, height, tile_size
+        self.pixels = bytearray(width * height * 3)
+        self.painted = set()
+
+    def paint_image(self, data):
+        w, h, px = decode_png(base64.b64decode(data["png"]))
+        assert (w, h) == (data["width"], data["height"]) == (self.width, self.height)
+        self.pixels[:] = px
+        self.painted = {(x, y) for x in range(0, w, self.tile_size) for y in range(0, h, self.tile_size)}
+
+    def paint_tile(self, data):
+        x, y, w, h, ts = data["x"], data["y"], data["w"], data["h"], self.tile_size
+        # Tiles lie on the tile grid and are clipped at the right and bottom edges.
+        assert x % ts == 0 and y % ts == 0, data
+        assert (w, h) == (min(ts, self.width - x), min(ts, self.height - y)), data
+        tw, th, px = decode_png(base64.b64decode(data["png"]))
+        assert (tw, th) == (w, h), f"tile PNG is {tw}x{th}, event says {w}x{h}"
+        for row in range(h):
+            start = ((y + row) * self.width + x) * 3
+            self.pixels[start:start + w * 3] = px[row * w * 3:(row + 1) * w * 3]
+        self.painted.add((x, y))
+
+    def tile_count(self):
+        ts = self.tile_size
+        return ((self.width + ts - 1) // ts) * ((self.height + ts - 1) // ts)
+
+
+# ---- the CLI renderer, with a job's normalised spec ----
+def cli_args(spec, threads=2):
+    """pathtracer flags for a job spec, every parameter explicit (the CLI's defaults differ)."""
+    args = ["-t", str(threads), "-s", str(spec["spp"]), "-m", str(spec["max_depth"]),
+            "-l", str(spec["light_samples"]), "-r", str(spec["width"]), str(spec["height"]),
+            "-b", repr(spec["aperture"]), "-d", repr(spec["focal_distance"]),
+            "--seed", str(spec["seed"]), "--tile", str(spec["tile_size"]), "--quiet"]
+    if spec["adaptive"]:
+        args += ["-a", str(spec["adaptive_batch"]), repr(spec["adaptive_tolerance"])]
+    else:
+        args += ["--no-adaptive"]
+    if spec["hemisphere"]:
+        args.append("-H")
+    if spec["file_camera"]:
+        args.append("--file-camera")
+    return args
+
+
+def render_cli(spec, scene_file, out_file, threads=2):
+    cmd = [str(PATHTRACER), *cli_args(spec, threads), "-f", str(out_file), str(scene_file)]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, f"{' '.join(cmd)}\n{done.stdout}{done.stderr}"
+    return Path(out_file).read_bytes()
+
+
+# ---- raw HTTP, for requests no client library would send ----
+def raw_request(port, data, timeout=10):
+    """Sends bytes as they are; returns (status, headers dict, body bytes) of the answer."""
+    with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
+        s.sendall(data)
+        buf = b""
+        while b"\r\n\r\n" not in buf:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            buf += chunk
+        head, _, body = buf.partition(b"\r\n\r\n")
+        lines = head.decode("latin-1").split("\r\n")
+        status = int(lines[0].split()[1])
+        headers = {k.strip().lower(): v.strip() for k, _, v in (l.partition(":") for l in lines[1:])}
+        length = int(headers.get("content-length", "0"))
+        while len(body) < length:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            body += chunk
+        return status, headers, body

@@ -1,0 +1,71 @@
+"""Cancelling: a running job stops within a second and its event stream ends; a queued job is
+cancelled at once and never runs; a finished job cannot be cancelled (409)."""
+import time
+
+from support import ENDLESS, TINY
+
+
+def test_cancel_running_job_within_a_second(server):
+    api = server.api
+    job = api.submit(ENDLESS)
+    api.wait(job["id"], "running", samples=1)
+    stream = server.events(job["id"])
+    assert stream.next().kind in ("image", "status")
+
+    t0 = time.monotonic()
+    answer = api.delete(f"/api/jobs/{job['id']}", expect=200).json()
+    assert answer["state"] in ("running", "cancelled")  # told to stop; the worker marks it
+    done = api.wait(job["id"], "cancelled", timeout=1.0, poll=0.01)
+    assert time.monotonic() - t0 < 1.0
+    assert done["finished_at"] is not None and done["progress"] < 1
+
+    # The stream ends with the cancelled state, soon.
+    events = stream.until_end()
+    assert events[-1].data == {"state": "cancelled"}
+    assert time.monotonic() - t0 < 2.0
+    assert [e for e in events if e.kind == "status"][-1].data["state"] == "cancelled"
+
+    # Nothing keeps rendering: the sample count stays put.
+    samples = api.job(job["id"])["samples"]
+    time.sleep(0.2)
+    assert api.job(job["id"])["samples"] == samples
+    assert api.get("/api/health").json() == {"status": "ok", "queued": 0, "running": 0}
+
+    # Cancelling again is a conflict.
+    err = api.error(api.delete(f"/api/jobs/{job['id']}"), 409)
+    assert "cancelled" in err["message"]
+
+
+def test_cancel_queued_job(server):
+    api = server.api
+    running = api.submit(ENDLESS)
+    api.wait(running["id"], "running")
+    queued = api.submit(TINY)
+    assert queued["state"] == "queued"
+    stream = server.events(queued["id"])
+    assert stream.next().data["state"] == "queued"
+
+    answer = api.delete(f"/api/jobs/{queued['id']}", expect=200).json()
+    assert answer["state"] == "cancelled" and answer["started_at"] is None
+    assert stream.until_end()[-1].data == {"state": "cancelled"}
+    assert api.get("/api/health").json()["queued"] == 0
+
+    # Freeing the worker does not start the cancelled job.
+    api.delete(f"/api/jobs/{running['id']}", expect=200)
+    api.wait(running["id"], "cancelled", timeout=1.0)
+    after = api.submit(TINY)
+    api.wait(after["id"], "done", timeout=20)
+    again = api.job(queued["id"])
+    assert again["state"] == "cancelled" and again["samples"] == 0 and again["started_at"] is None
+    api.error(api.get(f"/api/jobs/{queued['id']}/image.png", expect=None), 404)
+
+
+def test_delete_finished_or_unknown_job(server):
+    api = server.api
+    job = api.submit(TINY)
+    api.wait(job["id"], "done", timeout=20)
+    err = api.error(api.delete(f"/api/jobs/{job['id']}"), 409)
+    assert "done" in err["message"]
+    assert api.job(job["id"])["state"] == "done"  # unchanged
+    api.error(api.delete("/api/jobs/0123456789abcdef"), 404)
+    api.error(api.delete("/api/jobs/not-a-job"), 404)
