@@ -85,6 +85,7 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   p.adaptive_tolerance = float(r.number("adaptive_tolerance", 0.05, 0, 1));
   p.hemisphere = r.boolean("hemisphere", false);
   p.file_camera = r.boolean("file_camera", false);
+  p.keep_fov = r.boolean("keep_fov", false);
   p.tile_size = int(r.integer("tile_size", 32, 8, 256));
   s.time_limit = r.number("time_limit", 0, 0, 7 * 86400);
   s.target_error = r.number("target_error", 0, 0, 1);
@@ -133,6 +134,7 @@ json job_spec_to_json(const JobSpec& s) {
               {"adaptive_tolerance", short_float(p.adaptive_tolerance)},
               {"hemisphere", p.hemisphere},
               {"file_camera", p.file_camera},
+              {"keep_fov", p.keep_fov},
               {"tile_size", p.tile_size},
               {"time_limit", s.time_limit},
               {"target_error", s.target_error}};

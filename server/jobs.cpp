@@ -409,6 +409,11 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
           }
         job->tile_version[size_t(t.y0 / job->tile_size) * job->tiles_x + t.x0 / job->tile_size] = ++job->version;
         job->has_image = true;
+        // Progress and ETA move with every tile, not only at the end of a (doubling) pass.
+        job->progress = session.progress();
+        job->elapsed = std::chrono::duration<double>(clock::now() - start).count();
+        if (job->progress > 0 && job->spec.target_error <= 0 && job->spec.time_limit <= 0)
+          job->eta = job->elapsed * (1 - job->progress) / job->progress;
       }
       notify();
     };

@@ -10,6 +10,7 @@ const $ = (sel) => document.querySelector(sel);
 const FIELDS = {
   scene: 'select', max_depth: 'int', light_samples: 'int', aperture: 'num', focal_distance: 'num',
   spp: 'int', width: 'int', height: 'int', seed: 'int', time_limit: 'num', target_error: 'num', adaptive: 'bool',
+  keep_fov: 'bool',
 };
 const FINAL = new Set(['done', 'failed', 'cancelled']);
 const POLL_MS = 2000;
@@ -749,6 +750,8 @@ async function loadScenes() {
       else el.value = String(state.defaults[name]);
       if (kind !== 'bool') el.placeholder = String(state.defaults[name]);
     }
+    // The API keeps the course's cropping by default; on the page a small image shows the whole view.
+    input('keep_fov').checked = true;
   }
   showSceneSummary();
   return true;

@@ -462,6 +462,8 @@ def cli_args(spec, threads=2):
         args.append("-H")
     if spec["file_camera"]:
         args.append("--file-camera")
+    if spec.get("keep_fov"):
+        args.append("--keep-fov")
     return args
 
 
