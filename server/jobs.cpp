@@ -370,14 +370,13 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
     }
     notify();
 
-    // One flag stops the session: user cancel, shutdown, or the time limit (polled every 20 ms).
+    // One flag stops the session: user cancel or shutdown (polled every 20 ms). The time limit and
+    // the error target are the shared driver's (pt::run_progressive).
     std::atomic<bool> stop{false}, done{false};
     auto start = clock::now();
     std::thread poller([&] {
       while (!done) {
-        bool expired = job->spec.time_limit > 0 &&
-                       std::chrono::duration<double>(clock::now() - start).count() >= job->spec.time_limit;
-        if (job->cancel || m_stopping || expired) {
+        if (job->cancel || m_stopping) {
           stop = true;
           return;
         }
@@ -418,13 +417,9 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
       notify();
     };
 
-    int target = 1;
-    bool completed = true;
     auto last_persist = clock::now();
-    for (;;) {
-      completed = session.render_pass(target, &stop, on_tile);
+    auto on_pass = [&](const pt::PassReport& r) {
       pt::SessionStats st = session.stats();
-      double err = session.error_estimate();
       {
         std::lock_guard<std::mutex> lock(job->mutex);
         job->samples = st.samples;
@@ -432,14 +427,14 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
         job->nonfinite = st.nonfinite;
         job->elapsed = std::chrono::duration<double>(clock::now() - start).count();
         job->progress = session.progress();
-        if (std::isfinite(err)) {
-          job->error_estimate = err;
-          job->history.push_back({job->elapsed, double(st.samples) / (double(job->width) * job->height), err});
+        if (std::isfinite(r.error)) {
+          job->error_estimate = r.error;
+          job->history.push_back({job->elapsed, double(st.samples) / (double(job->width) * job->height), r.error});
         }
         // ETA from the sample budget, or (when sooner) from error ~ 1/spp towards the target.
         double eta = job->progress > 0 ? job->elapsed * (1 - job->progress) / job->progress : -1;
-        if (job->spec.target_error > 0 && std::isfinite(err) && err > 0)
-          eta = std::min(eta < 0 ? 1e30 : eta, job->elapsed * std::max(0.0, err / job->spec.target_error - 1));
+        if (job->spec.target_error > 0 && std::isfinite(r.error) && r.error > 0)
+          eta = std::min(eta < 0 ? 1e30 : eta, job->elapsed * std::max(0.0, r.error / job->spec.target_error - 1));
         if (job->spec.time_limit > 0) eta = std::min(eta < 0 ? 1e30 : eta, std::max(0.0, job->spec.time_limit - job->elapsed));
         job->eta = eta;
         ++job->version;
@@ -449,11 +444,9 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
         }
       }
       notify();
-      if (!completed) break;
-      if (session.finished() || target >= p.spp) break;
-      if (job->spec.target_error > 0 && err <= job->spec.target_error) break;
-      target = std::min(p.spp, target * 2);
-    }
+    };
+    pt::StopReason why = pt::run_progressive(session, {job->spec.time_limit, job->spec.target_error}, &stop, on_tile, on_pass);
+    bool completed = why != pt::StopReason::cancelled && why != pt::StopReason::time_limit;
 
     if (m_stopping && !job->cancel) {  // shutdown: run it again after a restart
       std::lock_guard<std::mutex> lock(job->mutex);
