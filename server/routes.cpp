@@ -101,7 +101,7 @@ void guarded(httplib::Response& res, F&& f) {
   }
 }
 
-// The PNG of one tile at its current version, encoded once and shared by every watcher.
+// One tile at its current version as base64 PNG text, encoded once and shared by every watcher.
 // Returns false when the job has no such tile yet.
 bool tile_png(Job& job, size_t idx, std::string& png, int& x, int& y, int& w, int& h, uint64_t& version) {
   std::vector<uint8_t> rgb;
@@ -121,7 +121,7 @@ bool tile_png(Job& job, size_t idx, std::string& png, int& x, int& y, int& w, in
     for (int r = 0; r < h; ++r)
       std::memcpy(&rgb[size_t(r) * w * 3], &job.display[(size_t(y + r) * job.width + x) * 3], size_t(w) * 3);
   }
-  png = pt::encode_png8(rgb, w, h);  // outside the lock: rendering never waits for encoding
+  png = base64(pt::encode_png8(rgb, w, h));  // outside the lock: rendering never waits for encoding
   std::lock_guard<std::mutex> lock(job.mutex);
   if (job.tile_png_version[idx] < version) {
     job.tile_png[idx] = png;
@@ -141,6 +141,12 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
   std::vector<uint64_t> sent;
   uint64_t seen = 0;
   bool first = true;
+  // Watchers cost the renderer CPU: tiles are batched per round (a round at most every 40 ms) and
+  // a status event goes out at most every 250 ms unless the state changes.
+  using clock = std::chrono::steady_clock;
+  const auto round_gap = std::chrono::milliseconds(40), status_gap = std::chrono::milliseconds(250);
+  clock::time_point last_status;
+  std::string last_state;
   auto write = [&](const std::string& s) { return sink.write(s.data(), s.size()); };
   if (!write("retry: 2000\n\n")) return;
   for (;;) {
@@ -160,12 +166,16 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
         continue;
       }
       version = job->version;
-      status = jobs.status_json(*job, false);
-      if (!job->history.empty()) {
-        const ErrorPoint& p = job->history.back();
-        status["error_point"] = {{"seconds", p.seconds}, {"spp", p.spp}, {"error", p.error}};
-      }
       final_state = is_final(job->state);
+      if (first || final_state || last_state != job_state_name(job->state) || clock::now() - last_status >= status_gap) {
+        status = jobs.status_json(*job, false);
+        if (!job->history.empty()) {
+          const ErrorPoint& p = job->history.back();
+          status["error_point"] = {{"seconds", p.seconds}, {"spp", p.spp}, {"error", p.error}};
+        }
+        last_state = job_state_name(job->state);
+        last_status = clock::now();
+      }
       has_image = job->has_image;
       if (sent.size() != job->tile_version.size()) sent.assign(job->tile_version.size(), 0);
       if (first && (has_image || job->state == JobState::done)) {
@@ -187,7 +197,8 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
       }
       first = false;
     }
-    if (!write(sse("status", status, version))) return;
+    if (!status.is_null() && !write(sse("status", status, version))) return;
+    bool sent_tiles = false;
     for (size_t i = 0; i < sent.size(); ++i) {
       uint64_t tv;
       {
@@ -200,14 +211,21 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
       uint64_t v;
       if (!tile_png(*job, i, png, x, y, w, h, v)) continue;
       // The id is this round's version, not the tile's: ids never go back within a stream.
-      if (!write(sse("tile", {{"x", x}, {"y", y}, {"w", w}, {"h", h}, {"png", base64(png)}}, version))) return;
+      if (!write(sse("tile", {{"x", x}, {"y", y}, {"w", w}, {"h", h}, {"png", png}}, version))) return;
       sent[i] = v;
+      sent_tiles = true;
     }
     seen = version;
     if (final_state) {
       write(sse("end", {{"state", status["state"]}}, version));
       return;
     }
+    // After a round that sent tiles, let more accumulate, but wake at once for a change of state.
+    if (!sent_tiles) continue;
+    std::unique_lock<std::mutex> lock(job->mutex);
+    job->changed.wait_for(lock, round_gap, [&] {
+      return last_state != job_state_name(job->state) || is_final(job->state) || jobs.stopping();
+    });
   }
 }
 
