@@ -72,6 +72,13 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--no-adaptive") { p.adaptive = false; }
     else if (a == "--keep-fov") { p.keep_fov = true; }
     else if (a == "--generic") { p.generic = true; }
+    else if (a == "--sampler") {
+      need(a, 1);
+      std::string v = args[++i];
+      if (v == "sobol") p.sampler = SamplerKind::sobol;
+      else if (v == "independent") p.sampler = SamplerKind::independent;
+      else throw UsageError("--sampler: '" + v + "' is not sobol or independent");
+    }
     else if (a == "--describe") { o.describe = true; }
     else if (a == "--error-log") { need(a, 1); o.error_log = args[++i]; }
     else if (a == "--reference") { need(a, 1); o.reference = args[++i]; }
@@ -132,6 +139,7 @@ std::string usage_text(const std::string& program) {
 "  --keep-fov      -r scales the course's 800x600 view to the output size instead of cropping it\n"
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
 "  --generic       run the path loop with every feature (for comparisons with the specialised one)\n"
+"  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"
 "\n"
 "Error against run time:\n"
 "  --error-log <FILE>     write one CSV row per pass: seconds, spp, error estimate (+ true error)\n"

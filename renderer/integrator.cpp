@@ -6,7 +6,7 @@
 // MIS: Veach 1997 ch. 9, power heuristic, light sampling taking `light_samples` samples.
 #include "materials.h"
 #include "render.h"
-#include "rng.h"
+#include "sampler.h"
 
 namespace pt {
 
@@ -54,7 +54,7 @@ int samples_for(const Light& light, const RenderParams& params) {
 
 // Light sampling at a non-delta vertex, every light, MIS-weighted against BSDF sampling.
 template <uint32_t F>
-Vec3 direct_light_sampling(const RenderScene& scene, const RenderParams& params, const Vertex& v, Pcg32& rng,
+Vec3 direct_light_sampling(const RenderScene& scene, const RenderParams& params, const Vertex& v, Sampler& rng,
                            uint64_t& rays) {
   Vec3 sum(0.0f);
   for (const Light& light : scene.lights) {
@@ -80,7 +80,7 @@ Vec3 direct_light_sampling(const RenderScene& scene, const RenderParams& params,
 // The course's -H estimator: (lights x light_samples) uniform hemisphere rays that count what
 // emits where they land.
 template <uint32_t F>
-Vec3 direct_hemisphere(const RenderScene& scene, const RenderParams& params, const Vertex& v, Pcg32& rng,
+Vec3 direct_hemisphere(const RenderScene& scene, const RenderParams& params, const Vertex& v, Sampler& rng,
                        uint64_t& rays) {
   int n = int(scene.lights.size()) * params.light_samples;
   if (n == 0) return Vec3(0.0f);
@@ -107,7 +107,7 @@ Vec3 direct_hemisphere(const RenderScene& scene, const RenderParams& params, con
 }
 
 template <uint32_t F>
-Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray, Pcg32& rng, uint64_t& rays) {
+Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray, Sampler& rng, uint64_t& rays) {
   Vec3 radiance(0.0f), beta(1.0f);
   bool specular = true;  // the camera ray counts as specular: emitters it sees get full weight
   float prev_pdf = 0;
@@ -193,7 +193,7 @@ Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray,
 
 }  // namespace
 
-Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, Pcg32& rng, uint64_t& rays) {
+Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, Sampler& rng, uint64_t& rays) {
   return trace_path_t<kFeatAll>(scene, params, ray, rng, rays);
 }
 

@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "materials.h"
-#include "rng.h"
+#include "sampler.h"
 
 namespace pt {
 
@@ -205,6 +205,8 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
   m_sum.assign(n, Vec3(0.0f));
   m_s1.assign(n, 0);
   m_s2.assign(n, 0);
+  m_half_s1.assign(n, 0);
+  m_half_n.assign(n, 0);
   m_count.assign(n, 0);
   m_done.assign(n, 0);
   int ts = params.tile_size;
@@ -231,14 +233,18 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
       while (m_count[i] < uint32_t(target)) {
         uint32_t s = m_count[i];
         if ((s & 15) == 15 && stop_requested(cancel)) break;
-        Pcg32 rng = make_sample_rng(p.seed, pixel_index, s);
+        Sampler rng(p.sampler, p.seed, pixel_index, s);
         Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
-        Vec2 lens = rng.next_2d();
+        Vec2 lens = cam.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};  // a pinhole needs none
         Ray ray = cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
         Vec3 l = trace(m_scene, p, ray, rng, rays);
         if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
           ++nonfinite;
           l = Vec3(0.0f);
+        }
+        if (s > 0 && (s & (s - 1)) == 0) {  // s samples so far, a power of two: keep their sum
+          m_half_s1[i] = m_s1[i];
+          m_half_n[i] = s;
         }
         m_sum[i] += l;
         double lum = luminance(l);
@@ -390,20 +396,23 @@ void RenderSession::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const 
 }
 
 double RenderSession::error_estimate() const {
-  // Relative MSE of the pixel means, estimated from their own sample variance:
-  // mean over pixels of Var[mean] / (mean^2 + eps), eps keeping black pixels finite
-  // (relMSE as in Rousselle et al. 2011 / Bitterli's benchmarks).
+  // Relative MSE of the pixel means: mean over pixels of Var[mean] / (mean^2 + eps) (relMSE as in
+  // Rousselle et al. 2011, eps keeping black pixels finite). Var[mean] comes from comparing the
+  // mean A of samples [0, P) with the mean B of [P, n), P the last power of two below n:
+  // E[(A - B)^2] P (n - P) / n^2 = sigma^2 / n for independent samples, and unlike the sample
+  // variance it also sees the faster convergence of stratified (Sobol) samples, each half of
+  // which is itself well stratified.
   double sum = 0;
-  size_t n = 0;
+  size_t used = 0;
   for (size_t i = 0; i < m_count.size(); ++i) {
-    uint32_t c = m_count[i];
-    if (c < 2) continue;
-    double mu = m_s1[i] / c;
-    double var = std::max(0.0, (m_s2[i] - m_s1[i] * m_s1[i] / c) / (c - 1));
-    sum += (var / c) / (mu * mu + kRelMseEpsilon);
-    ++n;
+    uint32_t n = m_count[i], p = m_half_n[i];
+    if (n < 2 || p == 0 || p >= n) continue;
+    double a = m_half_s1[i] / p, b = (m_s1[i] - m_half_s1[i]) / (n - p), mu = m_s1[i] / n;
+    double var_mean = (a - b) * (a - b) * double(p) * double(n - p) / (double(n) * n);
+    sum += var_mean / (mu * mu + kRelMseEpsilon);
+    ++used;
   }
-  return n ? sum / double(m_count.size()) : INFINITY;
+  return used ? sum / double(m_count.size()) : INFINITY;
 }
 
 SessionStats RenderSession::stats() const {

@@ -14,6 +14,7 @@
 #include "camera.h"
 #include "image.h"
 #include "lights.h"
+#include "sampler.h"
 #include "scene.h"
 
 namespace pt {
@@ -38,6 +39,7 @@ struct RenderParams {
   uint64_t seed = 0;               // --seed
   int tile_size = 32;
   bool generic = false;            // --generic: the path loop with every feature (for comparisons)
+  SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
 
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;
@@ -81,9 +83,9 @@ CameraParams camera_params(const RenderParams& params);
 float autofocus_distance(const RenderScene& scene, float sx, float sy);
 
 // One camera path's radiance (integrator.cpp), by the generic loop. `rays` counts every ray cast.
-Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, class Pcg32& rng, uint64_t& rays);
+Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, class Sampler& rng, uint64_t& rays);
 // The path loop specialised for a set of feature bits (one instantiation per combination).
-using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class Pcg32&, uint64_t&);
+using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class Sampler&, uint64_t&);
 PathTracer path_tracer_for(uint32_t feature_bits);
 
 struct Tile {
@@ -117,7 +119,7 @@ class RenderSession {
   double progress() const;
   ImageRGB image() const;        // mean radiance per pixel
   ImageRGB rate_image() const;   // the course's sample-rate colouring
-  // Estimated relative MSE of the image from per-pixel sample variance (no reference needed).
+  // Estimated relative MSE of the image, without a reference (see render.cpp).
   double error_estimate() const;
   SessionStats stats() const;
   const std::vector<Tile>& tiles() const { return m_tiles; }
@@ -137,7 +139,11 @@ class RenderSession {
   int m_frame_x0, m_frame_y0;  // film origin inside the full frame, top-left
   std::vector<Tile> m_tiles;
   std::vector<Vec3> m_sum;
-  std::vector<double> m_s1, m_s2;   // luminance sums for adaptive sampling and error estimates
+  std::vector<double> m_s1, m_s2;   // luminance sums for adaptive sampling (the course's test)
+  // The luminance sum at the last power-of-two sample count P below the current count n: the
+  // error estimate compares the mean of samples [0, P) with that of [P, n).
+  std::vector<double> m_half_s1;
+  std::vector<uint32_t> m_half_n;
   std::vector<uint32_t> m_count;
   std::vector<uint8_t> m_done;
   std::atomic<uint64_t> m_samples{0}, m_rays{0}, m_nonfinite{0};

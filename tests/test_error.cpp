@@ -21,7 +21,9 @@ double true_rel_mse(const ImageRGB& img, const ImageRGB& ref) {
 
 }  // namespace
 
-TEST(ErrorEstimate, StaysWithinAFactorOf1p5OfTheTrueErrorAcrossTheRun) {
+class ErrorEstimate : public ::testing::TestWithParam<SamplerKind> {};
+
+TEST_P(ErrorEstimate, StaysWithinAFactorOf1p5OfTheTrueErrorAcrossTheRun) {
   SceneDesc desc = load_collada(test::own_scene("dof.dae"));
   RenderParams p;
   p.file_camera = true;
@@ -40,6 +42,7 @@ TEST(ErrorEstimate, StaysWithinAFactorOf1p5OfTheTrueErrorAcrossTheRun) {
 
   p.spp = 256;
   p.seed = 1;
+  p.sampler = GetParam();
   RenderSession s(*scene, p);
   int checked = 0;
   for (int target = 1; target <= p.spp; target *= 2) {
@@ -54,7 +57,12 @@ TEST(ErrorEstimate, StaysWithinAFactorOf1p5OfTheTrueErrorAcrossTheRun) {
   EXPECT_EQ(checked, 6);
 }
 
-TEST(ErrorEstimate, FallsLikeOneOverSamplesAndIsFiniteOnBlackImages) {
+INSTANTIATE_TEST_SUITE_P(Samplers, ErrorEstimate, ::testing::Values(SamplerKind::sobol, SamplerKind::independent),
+                         [](const ::testing::TestParamInfo<SamplerKind>& i) {
+                           return std::string(i.param == SamplerKind::sobol ? "Sobol" : "Independent");
+                         });
+
+TEST(ErrorEstimateMc, FallsLikeOneOverSamplesAndIsFiniteOnBlackImages) {
   SceneDesc desc = load_collada(test::own_scene("dof.dae"));
   RenderParams p;
   p.file_camera = true;
@@ -63,6 +71,7 @@ TEST(ErrorEstimate, FallsLikeOneOverSamplesAndIsFiniteOnBlackImages) {
   p.max_depth = 2;
   p.adaptive = false;
   p.spp = 64;
+  p.sampler = SamplerKind::independent;  // plain Monte Carlo: error exactly ~ 1/spp
   auto scene = make_render_scene(desc, p);
   RenderSession s(*scene, p);
   s.render_pass(8);

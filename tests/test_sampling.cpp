@@ -1,6 +1,7 @@
 // Warps, discrete distributions, MIS weights, the random number generator and shading frames.
 // Distribution checks are chi-square goodness-of-fit tests at significance 1e-3 with fixed seeds,
 // so every run sees the same numbers.
+#include "sampler.h"
 #include "sampling.h"
 
 #include <gtest/gtest.h>
@@ -448,4 +449,82 @@ TEST(Distribution1D, EmptyDistributionHasNothingToSample) {
     EXPECT_EQ(prob, 0.0f);
     EXPECT_EQ(d->discrete_pdf(0), 0.0f);
   }
+}
+
+// ---- the per-sample sampler (renderer/sampler.h) ----
+
+TEST(Sampler, Dim1TablesMatchTheDirectionNumbers) {
+  for (uint32_t i : {0u, 1u, 2u, 3u, 255u, 256u, 12345u, 0xdeadbeefu, 0xffffffffu}) {
+    uint32_t r = 0, x = i;
+    for (uint32_t v = 1u << 31; x; x >>= 1, v ^= v >> 1)
+      if (x & 1) r ^= v;
+    EXPECT_EQ(pt::sobol_dim1(i), r) << i;
+  }
+}
+
+TEST(Sampler, EveryDimensionPairIsAStratifiedZeroTwoNet) {
+  // Owen scrambling keeps the (0,2)-net property: for 2^k samples of one pixel, every elementary
+  // interval of area 2^-k holds exactly one point, for each dimension pair.
+  const int k = 6, n = 1 << k;
+  for (uint64_t pixel : {0ull, 7ull, 123456ull}) {
+    for (int pair = 0; pair < 3; ++pair) {
+      for (int xbits = 0; xbits <= k; ++xbits) {
+        int ybits = k - xbits;
+        std::vector<int> cells(size_t(n), 0);
+        for (int s = 0; s < n; ++s) {
+          pt::Sampler smp(pt::SamplerKind::sobol, 42, pixel, uint32_t(s));
+          pt::Vec2 u;
+          for (int d = 0; d <= pair; ++d) u = smp.next_2d();
+          int cx = int(u.x * (1 << xbits)), cy = int(u.y * (1 << ybits));
+          ++cells[size_t(cy * (1 << xbits) + cx)];
+        }
+        for (int c : cells) ASSERT_EQ(c, 1) << "pixel " << pixel << " pair " << pair << " " << xbits << "x" << ybits;
+      }
+    }
+  }
+}
+
+TEST(Sampler, DimensionsAreUniformAndUncorrelated) {
+  // Over many pixels, each draw is uniform and draws of different dimensions are uncorrelated.
+  const int pixels = 4096, spp = 8;
+  std::vector<double> sum(8, 0), sum2(8, 0);
+  double cross01 = 0, cross12 = 0, cross_xy = 0;
+  int n = 0;
+  for (int p = 0; p < pixels; ++p)
+    for (int s = 0; s < spp; ++s) {
+      pt::Sampler smp(pt::SamplerKind::sobol, 1, uint64_t(p), uint32_t(s));
+      pt::Vec2 a = smp.next_2d(), b = smp.next_2d();
+      float c = smp.next_float();
+      pt::Vec2 d = smp.next_2d();
+      double v[8] = {a.x, a.y, b.x, b.y, c, d.x, d.y, 0.5};
+      for (int i = 0; i < 8; ++i) {
+        sum[i] += v[i];
+        sum2[i] += v[i] * v[i];
+      }
+      cross01 += (a.x - 0.5) * (b.x - 0.5);
+      cross12 += (b.y - 0.5) * (c - 0.5);
+      cross_xy += (a.x - 0.5) * (a.y - 0.5);
+      ++n;
+    }
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(sum[i] / n, 0.5, 5 * std::sqrt(1.0 / 12 / n)) << i;
+    EXPECT_NEAR(sum2[i] / n, 1.0 / 3, 0.01) << i;
+  }
+  double tol = 5 * (1.0 / 12) / std::sqrt(double(n));
+  EXPECT_NEAR(cross01 / n, 0, tol);
+  EXPECT_NEAR(cross12 / n, 0, tol);
+  EXPECT_NEAR(cross_xy / n, 0, tol);
+}
+
+TEST(Sampler, SameInputsSameNumbersAndIndependentModeIsPcg) {
+  pt::Sampler a(pt::SamplerKind::sobol, 3, 10, 5), b(pt::SamplerKind::sobol, 3, 10, 5), c(pt::SamplerKind::sobol, 3, 11, 5);
+  pt::Vec2 ua = a.next_2d(), ub = b.next_2d(), uc = c.next_2d();
+  EXPECT_EQ(ua.x, ub.x);
+  EXPECT_EQ(ua.y, ub.y);
+  EXPECT_NE(ua.x, uc.x);
+  pt::Sampler ind(pt::SamplerKind::independent, 3, 10, 5);
+  pt::Pcg32 rng = pt::make_sample_rng(3, 10, 5);
+  pt::Vec2 ui = ind.next_2d(), ur = rng.next_2d();
+  EXPECT_EQ(ui.x, ur.x);
+  EXPECT_EQ(ui.y, ur.y);
 }
