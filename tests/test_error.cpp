@@ -7,19 +7,6 @@
 
 using namespace pt;
 
-namespace {
-
-// True relative MSE of `img` against `ref`, on luminance, with the estimate's epsilon.
-double true_rel_mse(const ImageRGB& img, const ImageRGB& ref) {
-  double s = 0;
-  for (size_t i = 0; i < img.pixels.size(); ++i) {
-    double a = luminance(img.pixels[i]), b = luminance(ref.pixels[i]);
-    s += (a - b) * (a - b) / (b * b + 1e-2);
-  }
-  return s / img.pixels.size();
-}
-
-}  // namespace
 
 class ErrorEstimate : public ::testing::TestWithParam<SamplerKind> {};
 
@@ -48,7 +35,7 @@ TEST_P(ErrorEstimate, StaysWithinAFactorOf1p5OfTheTrueErrorAcrossTheRun) {
   for (int target = 1; target <= p.spp; target *= 2) {
     s.render_pass(target);
     if (target < 8) continue;  // a per-pixel variance from fewer samples is too rough to judge
-    double truth = true_rel_mse(s.image(), reference) - ref_error;
+    double truth = relative_mse(s.image(), reference) - ref_error;
     double estimate = s.error_estimate();
     EXPECT_GT(estimate, truth / 1.5) << target << " spp";
     EXPECT_LT(estimate, truth * 1.5) << target << " spp";
