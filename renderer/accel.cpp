@@ -10,6 +10,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace pt {
 
@@ -179,9 +180,32 @@ inline void to_embree(const Ray& r, RTCRay& e) {
   e.flags = 0;
 }
 
+// Embree asserts, aborting the whole process (Debian builds it with assertions), on a ray it deems
+// invalid: a NaN, or an origin or direction component beyond FLT_LARGE (1.844e18). A scene with
+// coordinates near 1e38 makes such rays (the course camera backs off 1.5 bounding-box diagonals);
+// they are treated as misses instead. Found by the scene fuzzer (tests/fuzz-regressions).
+inline bool embree_accepts(const Ray& r) {
+  constexpr float kLarge = 1.844e18f;
+  return std::fabs(r.o.x) <= kLarge && std::fabs(r.o.y) <= kLarge && std::fabs(r.o.z) <= kLarge &&
+         std::fabs(r.d.x) <= kLarge && std::fabs(r.d.y) <= kLarge && std::fabs(r.d.z) <= kLarge &&
+         !std::isnan(r.tmin) && !std::isnan(r.tmax);
+}
+
+thread_local RayRecorder* t_recorder = nullptr;  // benchmarks only: see record_rays_on_this_thread
+
+// Out of line and cold, so the unset case stays one thread-local load and a branch.
+[[gnu::noinline, gnu::cold]] void record_ray(const Ray& ray, uint8_t shadow) {
+  t_recorder->rays.push_back(ray);
+  t_recorder->shadow.push_back(shadow);
+}
+
 }  // namespace
 
+void record_rays_on_this_thread(RayRecorder* r) { t_recorder = r; }
+
 bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
+  if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(ray, 0);
+  if (!embree_accepts(ray)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
@@ -231,12 +255,67 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
 }
 
 bool Accel::occluded(const Ray& ray) const {
+  if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(ray, 1);
+  if (!embree_accepts(ray)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRay r;
   to_embree(ray, r);
   rtcOccluded1(m_impl->scene, &ctx, &r);
   return r.tfar < 0;  // Embree sets tfar = -inf on a hit
+}
+
+size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, size_t batch) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);  // incoherent rays, as a path tracer casts them
+  RTCScene scene = m_impl->scene;
+  size_t hits = 0;
+  if (batch <= 1) {
+    for (size_t i = 0; i < n; ++i) {
+      if (shadow[i]) {
+        RTCRay r;
+        to_embree(rays[i], r);
+        rtcOccluded1(scene, &ctx, &r);
+        hits += r.tfar < 0;
+      } else {
+        RTCRayHit rh;
+        to_embree(rays[i], rh.ray);
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(scene, &ctx, &rh);
+        hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      }
+    }
+    return hits;
+  }
+  std::vector<RTCRayHit> hit_rays(batch);
+  std::vector<RTCRay> shadow_rays(batch);
+  size_t nh = 0, ns = 0;
+  auto flush_hits = [&] {
+    rtcIntersect1M(scene, &ctx, hit_rays.data(), unsigned(nh), sizeof(RTCRayHit));
+    for (size_t k = 0; k < nh; ++k) hits += hit_rays[k].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    nh = 0;
+  };
+  auto flush_shadows = [&] {
+    rtcOccluded1M(scene, &ctx, shadow_rays.data(), unsigned(ns), sizeof(RTCRay));
+    for (size_t k = 0; k < ns; ++k) hits += shadow_rays[k].tfar < 0;
+    ns = 0;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    if (shadow[i]) {
+      to_embree(rays[i], shadow_rays[ns++]);
+      if (ns == batch) flush_shadows();
+    } else {
+      RTCRayHit& rh = hit_rays[nh++];
+      to_embree(rays[i], rh.ray);
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      if (nh == batch) flush_hits();
+    }
+  }
+  if (nh) flush_hits();
+  if (ns) flush_shadows();
+  return hits;
 }
 
 Vec3 offset_ray_origin(Vec3 p, Vec3 n) {

@@ -2,6 +2,7 @@
 // one file that includes Embree.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -45,11 +46,26 @@ class Accel {
   // memory monitor reports) plus our per-triangle shading data.
   size_t memory_bytes() const;
 
+  // Benchmarks only (bench/ceiling.cpp; the renderer never calls it): casts rays[0, n) straight
+  // through Embree, rtcIntersect1 / rtcOccluded1 per ray when batch <= 1, else Embree's stream API
+  // (rtcIntersect1M / rtcOccluded1M, `batch` rays a call, intersect and shadow rays gathered
+  // separately). shadow[i] != 0 makes ray i an occlusion query. Returns how many rays hit.
+  size_t cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, size_t batch) const;
+
   struct Impl;
 
  private:
   std::unique_ptr<Impl> m_impl;
 };
+
+// Benchmarks only: every ray a thread passes to Accel::intersect / occluded, in order.
+struct RayRecorder {
+  std::vector<Ray> rays;
+  std::vector<uint8_t> shadow;  // 1: an occluded() query, 0: intersect()
+};
+// Starts (or with nullptr stops) recording the calling thread's rays into `r`. Unset (the
+// default) it costs one thread-local pointer test per query.
+void record_rays_on_this_thread(RayRecorder* r);
 
 // A ray leaving the surface in direction d, origin pushed off to the side d points to.
 // Offsets follow Waechter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection",

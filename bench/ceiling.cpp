@@ -1,0 +1,143 @@
+// bench_ceiling: how fast Embree alone traces the rays our path tracer casts. Records every ray
+// of one 16-spp pass (record_rays_on_this_thread, renderer/accel.h), then replays the list in a
+// tight loop with 1 and 2 threads (the list split in halves) three ways: through Accel::intersect
+// / occluded (our wrapper, hit refinement included), raw rtcIntersect1 / rtcOccluded1, and Embree's
+// stream API (rtcIntersect1M / rtcOccluded1M). The path tracer's own rays/s on the same pass over
+// the replay's is the share of its time the ray queries would take if nothing else cost anything.
+//
+//   bench_ceiling [--spp 16] [--runs 5] [--scene NAME] [--sampler sobol|independent] [--smoke]
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench_common.h"
+#include "collada.h"
+#include "progress.h"
+#include "render.h"
+
+using namespace pt;
+using namespace bench;
+
+namespace {
+
+const char* kUsage = "bench_ceiling [--spp N=16] [--runs N=5] [--batch N=256] [--scene NAME] [--sampler sobol|independent] [--smoke]";
+
+enum class Mode { accel, raw, stream };
+
+size_t replay(const Accel& a, const RayRecorder& rec, size_t begin, size_t end, Mode mode, size_t batch) {
+  const Ray* rays = rec.rays.data();
+  const uint8_t* shadow = rec.shadow.data();
+  if (mode == Mode::raw) return a.cast_raw(rays + begin, shadow + begin, end - begin, 1);
+  if (mode == Mode::stream) return a.cast_raw(rays + begin, shadow + begin, end - begin, batch);
+  size_t hits = 0;
+  SurfaceHit h;
+  for (size_t i = begin; i < end; ++i) hits += shadow[i] ? a.occluded(rays[i]) : a.intersect(rays[i], h);
+  return hits;
+}
+
+// Rays per second of one replay of the whole list with `threads` threads.
+double replay_rate(const Accel& a, const RayRecorder& rec, int threads, Mode mode, size_t batch) {
+  const size_t n = rec.rays.size();
+  std::vector<size_t> hits(size_t(threads), 0);
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t)
+    pool.emplace_back([&, t] { hits[size_t(t)] = replay(a, rec, n * t / threads, n * (t + 1) / threads, mode, batch); });
+  hits[0] = replay(a, rec, 0, n / threads, mode, batch);
+  for (auto& th : pool) th.join();
+  double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  static std::atomic<size_t> sink{0};
+  for (size_t h : hits) sink += h;
+  return double(n) / sec;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, also into a file
+  Args args(argc, argv);
+  if (args.flag("--help") || args.flag("-h")) {
+    std::printf("usage: %s\n", kUsage);
+    return 0;
+  }
+  const bool smoke = args.flag("--smoke");
+  const int spp = args.integer("--spp", smoke ? 2 : 16);
+  const int runs = std::max(1, args.integer("--runs", smoke ? 1 : 5));
+  const size_t batch = size_t(std::max(2, args.integer("--batch", 256)));
+  const std::string only = args.value("--scene", "");
+  const SamplerKind sampler = args.sampler();
+  args.finish(kUsage);
+
+  std::vector<BenchScene> scenes = bench_scenes("bench_ceiling", smoke, only);
+  std::printf("bench_ceiling: rays of one %d-spp pass at %s (keep_fov, m = 5, light_samples 1, no adaptive), "
+              "%s sampler, replayed; rays/s are medians of %d runs\n",
+              spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);
+  std::vector<std::string> table;
+  ProgressBar bar("bench_ceiling");
+  int done = 0;
+  const int total = int(scenes.size()) * 2 * 4 * runs;
+  for (BenchScene sc : scenes) {
+    sc.max_depth = 5;
+    SceneDesc desc = load_collada(sc.path);
+    RenderParams p = bench_params(sc, smoke);
+    p.sampler = sampler;
+    p.spp = spp;
+    auto scene = make_render_scene(desc, p);
+
+    // Record on this thread: a one-thread session renders on the calling thread.
+    RayRecorder rec;
+    uint64_t pt_rays = 0, pt_samples = 0;
+    {
+      RenderParams p1 = p;
+      p1.threads = 1;
+      RenderSession s(*scene, p1);
+      record_rays_on_this_thread(&rec);
+      s.render_pass(spp);
+      record_rays_on_this_thread(nullptr);
+      pt_rays = s.stats().rays;
+      pt_samples = s.stats().samples;
+    }
+    if (pt_rays != rec.rays.size())
+      std::printf("%s: warning: the session counted %llu rays, the recorder saw %zu\n", sc.name.c_str(),
+                  static_cast<unsigned long long>(pt_rays), rec.rays.size());
+    size_t shadows = 0;
+    for (uint8_t s : rec.shadow) shadows += s;
+
+    const Accel& accel = *scene->accel;
+    for (Mode m : {Mode::accel, Mode::raw, Mode::stream}) replay_rate(accel, rec, 1, m, batch);  // warm up
+    for (int threads : {1, 2}) {
+      std::vector<double> pt_rate, acc, raw, stream;
+      for (int r = 0; r < runs; ++r) {  // interleaved, so drift hits every column alike
+        RenderParams pt = p;
+        pt.threads = threads;
+        RenderSession s(*scene, pt);
+        s.render_pass(spp);
+        pt_rate.push_back(s.stats().rays / s.stats().seconds);
+        bar.update(double(++done) / total);
+        acc.push_back(replay_rate(accel, rec, threads, Mode::accel, batch));
+        bar.update(double(++done) / total);
+        raw.push_back(replay_rate(accel, rec, threads, Mode::raw, batch));
+        bar.update(double(++done) / total);
+        stream.push_back(replay_rate(accel, rec, threads, Mode::stream, batch));
+        bar.update(double(++done) / total);
+      }
+      char line[512];
+      std::snprintf(line, sizeof line, "%-10s %7d %8.2f M %7.1f%% %9.2f %9.2f M %11.2f M %10.2f %9.2f M %11.2f M",
+                    sc.name.c_str(), threads, rec.rays.size() / 1e6, 100.0 * shadows / std::max<size_t>(1, rec.rays.size()),
+                    double(pt_rays) / std::max<uint64_t>(1, pt_samples), median(pt_rate) / 1e6, median(acc) / 1e6,
+                    median(pt_rate) / median(acc), median(raw) / 1e6, median(stream) / 1e6);
+      table.push_back(line);
+    }
+  }
+  bar.finish();
+  std::printf("%-10s %7s %10s %8s %9s %11s %13s %10s %11s %13s\n", "scene", "threads", "rays", "shadow", "rays/spl",
+              "PT rays/s", "replay rays/s", "PT/replay", "raw 1 rays/s", "stream rays/s");
+  for (const std::string& l : table) std::printf("%s\n", l.c_str());
+  std::printf("PT = the path tracer's rays/s on the same pass; replay = Accel::intersect / occluded; raw 1 = "
+              "rtcIntersect1 / rtcOccluded1; stream = rtcIntersect1M / rtcOccluded1M, %zu rays a call\n",
+              batch);
+  return 0;
+}

@@ -1,0 +1,73 @@
+// bench_scaling: samples/s of the path tracer with 1 and 2 threads and their ratio, in the issue's
+// framing (480x360 keep_fov, light_samples 1, no adaptive sampling). Numbers only.
+//
+//   bench_scaling [--spp 16] [--runs 3] [--scene NAME] [--sampler sobol|independent] [--depth M] [--smoke]
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "bench_common.h"
+#include "collada.h"
+#include "progress.h"
+#include "render.h"
+
+using namespace pt;
+using namespace bench;
+
+namespace {
+const char* kUsage = "bench_scaling [--spp N=16] [--runs N=3] [--scene NAME] [--sampler sobol|independent] [--depth M] [--smoke]";
+}
+
+int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, also into a file
+  Args args(argc, argv);
+  if (args.flag("--help") || args.flag("-h")) {
+    std::printf("usage: %s\n", kUsage);
+    return 0;
+  }
+  const bool smoke = args.flag("--smoke");
+  const int spp = args.integer("--spp", smoke ? 2 : 16);
+  const int runs = std::max(1, args.integer("--runs", smoke ? 1 : 3));
+  const std::string only = args.value("--scene", "");
+  const SamplerKind sampler = args.sampler();
+  const int depth = args.integer("--depth", -1);  // overrides every scene's max depth
+  args.finish(kUsage);
+
+  std::vector<BenchScene> scenes = bench_scenes("bench_scaling", smoke, only);
+  std::printf("bench_scaling: one %d-spp pass at %s (keep_fov, light_samples 1, no adaptive, %s sampler), median of "
+              "%d runs\n",
+              spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);
+  std::vector<std::string> table;
+  ProgressBar bar("bench_scaling");
+  int done = 0;
+  const int total = int(scenes.size()) * runs * 2;
+  for (const BenchScene& sc : scenes) {
+    SceneDesc desc = load_collada(sc.path);
+    RenderParams p = bench_params(sc, smoke);
+    p.sampler = sampler;
+    if (depth >= 0) p.max_depth = depth;
+    p.spp = spp;
+    auto scene = make_render_scene(desc, p);
+    std::vector<double> sps[2], rps[2];
+    for (int r = 0; r < runs; ++r)
+      for (int t = 0; t < 2; ++t) {  // interleaved, so drift hits both alike
+        RenderParams pt = p;
+        pt.threads = t + 1;
+        RenderSession s(*scene, pt);
+        s.render_pass(spp);
+        sps[t].push_back(s.stats().samples / s.stats().seconds);
+        rps[t].push_back(s.stats().rays / s.stats().seconds);
+        bar.update(double(++done) / total);
+      }
+    char line[256];
+    std::snprintf(line, sizeof line, "%-10s %4d %10.3f M %10.3f M %7.2f %10.2f M %10.2f M", sc.name.c_str(),
+                  p.max_depth, median(sps[0]) / 1e6, median(sps[1]) / 1e6, median(sps[1]) / median(sps[0]),
+                  median(rps[0]) / 1e6, median(rps[1]) / 1e6);
+    table.push_back(line);
+  }
+  bar.finish();
+  std::printf("%-10s %4s %12s %12s %7s %12s %12s\n", "scene", "m", "samples/s 1t", "samples/s 2t", "2t/1t",
+              "rays/s 1t", "rays/s 2t");
+  for (const std::string& l : table) std::printf("%s\n", l.c_str());
+  return 0;
+}
