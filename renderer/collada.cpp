@@ -2,8 +2,12 @@
 // The dialect is described in scenes/README.md; deviations from the course parser in docs/cs184-compat.md.
 #include "collada.h"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -12,6 +16,9 @@
 
 namespace pt {
 namespace {
+
+// User text quoted in a message, cut short: an id or URL of a megabyte must not become the message.
+std::string clip(const std::string& s, size_t n = 60) { return s.size() <= n ? s : s.substr(0, n) + "..."; }
 
 class Reader {
  public:
@@ -33,9 +40,9 @@ class Reader {
     if (node) {
       int line = line_of(node);
       if (line > 0) s << ":" << line;
-      s << ": <" << node.name();
-      if (auto id = node.attribute("id")) s << " id='" << id.value() << "'";
-      else if (auto sid = node.attribute("sid")) s << " sid='" << sid.value() << "'";
+      s << ": <" << clip(node.name());
+      if (auto id = node.attribute("id")) s << " id='" << clip(id.value()) << "'";
+      else if (auto sid = node.attribute("sid")) s << " sid='" << clip(sid.value()) << "'";
       s << ">";
     }
     return s.str();
@@ -43,8 +50,17 @@ class Reader {
   [[noreturn]] void fail(const pugi::xml_node& node, const std::string& msg) const {
     throw SceneError(where(node) + ": " + msg);
   }
+  // Capped per file: a million <skew> elements must not print a million lines (each line number
+  // also costs a scan of the text).
   void warn(const pugi::xml_node& node, const std::string& msg) const {
+    if (++m_warnings > m_limits.max_warnings) return;
     std::fprintf(stderr, "warning: %s: %s\n", where(node).c_str(), msg.c_str());
+  }
+  // Every number and index read counts, again when instancing reads an array again: instancing
+  // cannot multiply the work without bound.
+  void count_value(const pugi::xml_node& node) const {
+    if (++m_values > m_limits.max_values)
+      fail(node, "more than " + std::to_string(m_limits.max_values) + " numbers read (instancing included)");
   }
 
   // ---- values ----
@@ -64,7 +80,8 @@ class Reader {
         while (e < end && !std::isspace((unsigned char)*e)) ++e;
         fail(node, "'" + std::string(start, std::min<size_t>(e - start, 40)) + "' is not a number");
       }
-      if (!std::isfinite(v)) fail(node, "non-finite number '" + std::string(start, r.ptr - start) + "'");
+      if (!std::isfinite(v)) fail(node, "non-finite number '" + clip(std::string(start, r.ptr - start)) + "'");
+      count_value(node);
       out.push_back(v);
       s = r.ptr;
     }
@@ -84,6 +101,7 @@ class Reader {
         while (e < end && !std::isspace((unsigned char)*e)) ++e;
         fail(node, "'" + std::string(s, std::min<size_t>(e - s, 40)) + "' is not a non-negative integer index");
       }
+      count_value(node);
       out.push_back(v);
       s = r.ptr;
     }
@@ -114,9 +132,9 @@ class Reader {
   pugi::xml_node lookup_url(const pugi::xml_node& node, const char* attr = "url") const {
     std::string url = node.attribute(attr).value();
     if (url.empty()) fail(node, std::string("missing attribute '") + attr + "'");
-    if (url[0] != '#') fail(node, "only local references ('#id') are supported, got '" + url + "'");
+    if (url[0] != '#') fail(node, "only local references ('#id') are supported, got '" + clip(url) + "'");
     auto it = m_ids.find(url.substr(1));
-    if (it == m_ids.end()) fail(node, "reference '" + url + "' names no element");
+    if (it == m_ids.end()) fail(node, "reference '" + clip(url) + "' names no element");
     return it->second;
   }
 
@@ -140,11 +158,23 @@ class Reader {
   int m_default_material = -1;
   size_t m_node_count = 0;
   size_t m_triangle_count = 0;
+  mutable size_t m_values = 0;
+  mutable int m_warnings = 0;
   SceneDesc m_scene;
   Mat4 m_up;
 };
 
 SceneDesc Reader::read() {
+  if (m_text.size() > m_limits.max_file_bytes)
+    throw SceneError(m_name + ": " + std::to_string(m_text.size()) + " bytes, over the limit of " +
+                     std::to_string(m_limits.max_file_bytes));
+  // Elements and attributes, counted before pugixml builds a DOM node for each: millions of tiny
+  // elements fail here in one pass over the text instead of after gigabytes of nodes.
+  size_t markup = 0;
+  for (size_t i = 0; i + 1 < m_text.size(); ++i)
+    markup += (m_text[i] == '<' && m_text[i + 1] != '/') || m_text[i] == '=';
+  if (markup > m_limits.max_markup)
+    throw SceneError(m_name + ": more than " + std::to_string(m_limits.max_markup) + " XML elements and attributes");
   pugi::xml_parse_result res = m_doc.load_buffer(m_text.data(), m_text.size(), pugi::parse_default, pugi::encoding_auto);
   if (!res) {
     int line = 1 + int(std::count(m_text.begin(), m_text.begin() + std::min<size_t>(res.offset, m_text.size()), '\n'));
@@ -185,7 +215,7 @@ SceneDesc Reader::read() {
       } else if (axis == "X_UP") {  // (x, y, z) -> (y, x, -z)
         m.m[0][1] = 1; m.m[1][0] = 1; m.m[2][2] = -1;
       } else {
-        fail(up, "up_axis must be X_UP, Y_UP or Z_UP, got '" + axis + "'");
+        fail(up, "up_axis must be X_UP, Y_UP or Z_UP, got '" + clip(axis) + "'");
       }
       m_up = m;
     }
@@ -201,6 +231,8 @@ SceneDesc Reader::read() {
 
   if (m_scene.meshes.empty() && m_scene.spheres.empty() && m_scene.lights.empty())
     fail(vs, "the scene has no geometry and no lights");
+  if (m_warnings > m_limits.max_warnings)
+    std::fprintf(stderr, "warning: %s: %d more warnings not shown\n", m_name.c_str(), m_warnings - m_limits.max_warnings);
   return std::move(m_scene);
 }
 
@@ -349,7 +381,7 @@ void Reader::read_light(const pugi::xml_node& inst, const Mat4& world) {
   } else if (type == "ambient") {
     l.type = LightType::ambient;
   } else {
-    fail(kind, "unsupported light type '" + type + "' (area, point, spot, directional, ambient)");
+    fail(kind, "unsupported light type '" + clip(type) + "' (area, point, spot, directional, ambient)");
   }
   m_scene.lights.push_back(l);
 }
@@ -479,7 +511,7 @@ void Reader::read_mesh(const pugi::xml_node& mesh, const pugi::xml_node& inst, c
   std::vector<double> raw = numbers(fa);
   if (auto count = fa.attribute("count")) {
     if (count.as_ullong() != raw.size())
-      fail(fa, "count says " + std::string(count.value()) + " but " + std::to_string(raw.size()) + " numbers are present");
+      fail(fa, "count says " + clip(count.value()) + " but " + std::to_string(raw.size()) + " numbers are present");
   }
   size_t stride = 3;
   if (pugi::xml_node acc = source.child("technique_common").child("accessor")) {

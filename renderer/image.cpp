@@ -3,10 +3,13 @@
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
 namespace pt {
@@ -64,11 +67,27 @@ void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, OIIO::Ty
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw std::runtime_error(path + ": cannot write this image format (" + OIIO::geterror() + ")");
   std::string tmp = temp_name(path);
+  errno = 0;
   if (!out->open(tmp, spec) || !out->write_image(type, data) || !out->close()) {
+    // OpenImageIO's message does not say why a write failed: the system's reason does (full disk,
+    // file-size limit, read-only or vanished folder).
+    int why = errno;
     std::string err = out->geterror();
+    if (why == ENOSPC || why == EFBIG || why == EDQUOT || why == EROFS || why == EIO || why == ENOENT || why == ENOTDIR ||
+        why == EACCES)
+      err += std::string(err.empty() ? "" : " ") + "(" + std::strerror(why) + ")";
     std::remove(tmp.c_str());
     throw std::runtime_error(path + ": cannot write image: " + err);
   }
+  // On the disk before the rename: after a crash the name holds the old file or the whole new one.
+  int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    std::string err = std::strerror(errno);
+    if (fd >= 0) ::close(fd);
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot write image: " + err);
+  }
+  ::close(fd);
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
     throw std::runtime_error(path + ": cannot move the finished image into place");

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The test command: installs dependencies, builds, runs every test with ctest.
+# The test command: installs dependencies, builds, runs every test with ctest; then the sanitizer
+# run and a short fuzzing run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -10,5 +11,8 @@ if [ ! -f tests/web/node_modules/.package-lock.json ] ||
   (cd tests/web && npm ci --no-audit --no-fund)
 fi
 bash scripts/python-env.sh  # build/venv: pytest, requests, jsonschema, schemathesis for tests/server
-cd build
-ctest --output-on-failure --timeout 900 -j "$(nproc)"
+(cd build && ctest --output-on-failure --timeout 900 -j "$(nproc)")
+# The C++ and server tests again under AddressSanitizer + UBSan (build-asan), then the scene loader
+# under libFuzzer for a minute (build-fuzz); docs/reliability.md has the longer runs.
+bash scripts/asan.sh
+bash scripts/fuzz.sh 60

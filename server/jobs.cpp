@@ -3,9 +3,12 @@
 #include "jobs.h"
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -54,22 +57,45 @@ void make_dirs(const std::string& path) {
   }
 }
 
-// Writes a whole file under a temp name and renames it into place: readers never see a partial file.
+// Writes a whole file under a temp name, flushes it to the disk and renames it into place: readers,
+// and a server restarted after a crash, never see a partial file. Errors name the file and the cause
+// (no space, not a directory, ...).
 void write_file_atomic(const std::string& path, const std::string& data) {
   std::string tmp = path + ".tmp" + std::to_string(getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(data.data(), std::streamsize(data.size()));
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw std::runtime_error("cannot write " + path);
-    }
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  size_t done = 0;
+  int err = 0;
+  while (done < data.size() && !err) {
+    ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0 && errno != EINTR) err = errno;
+    if (n > 0) done += size_t(n);
+  }
+  if (!err && ::fsync(fd) != 0) err = errno;
+  if (::close(fd) != 0 && !err) err = errno;
+  if (err) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot write " + path + ": " + std::strerror(err));
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    err = errno;
     std::remove(tmp.c_str());
-    throw std::runtime_error("cannot move " + path + " into place");
+    throw std::runtime_error("cannot move " + path + " into place: " + std::strerror(err));
   }
+}
+
+// Temp files a killed server left behind (job.json.tmp<pid>, .image.exr.tmp<pid>-<n>): never read,
+// removed at start so they cannot pile up. Returns how many.
+int remove_temp_files(const std::string& dir) {
+  int removed = 0;
+  if (DIR* d = opendir(dir.c_str())) {
+    while (dirent* e = readdir(d)) {
+      std::string name = e->d_name;
+      if (name.find(".tmp") != std::string::npos && std::remove((dir + "/" + name).c_str()) == 0) ++removed;
+    }
+    closedir(d);
+  }
+  return removed;
 }
 
 bool read_file(const std::string& path, std::string& out) {
@@ -111,9 +137,14 @@ std::string JobManager::job_dir(const std::string& id) const { return m_config.d
 
 void JobManager::start() {
   make_dirs(m_config.data_dir + "/jobs");
-  struct stat st;
-  if (stat((m_config.data_dir + "/jobs").c_str(), &st) != 0 || access((m_config.data_dir + "/jobs").c_str(), W_OK) != 0)
-    throw std::runtime_error("data directory '" + m_config.data_dir + "' is not writable");
+  // A real write, not access(): root passes access() on a read-only mount or a full disk.
+  try {
+    std::string probe = m_config.data_dir + "/jobs/.write-probe";
+    write_file_atomic(probe, "ok\n");
+    std::remove(probe.c_str());
+  } catch (const std::exception& e) {
+    throw std::runtime_error("data directory '" + m_config.data_dir + "' is not writable (" + e.what() + ")");
+  }
   load_persisted();
   for (int i = 0; i < std::max(1, m_config.concurrency); ++i) m_workers.emplace_back([this] { worker_loop(); });
 }
@@ -161,9 +192,17 @@ std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const
   job->idempotency_key = key;
   job->created_at = now_unix();
   {
+    // Stored before it is acknowledged: a job the client was told about survives a crash.
     std::lock_guard<std::mutex> jl(job->mutex);
     make_dirs(job_dir(job->id));
-    persist(*job);
+    try {
+      write_job_file(*job);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "render-server: job %s: %s\n", job->id.c_str(), e.what());
+      rmdir(job_dir(job->id).c_str());
+      std::string why = e.what();
+      throw ApiError(507, "the data directory cannot store the job (" + why.substr(why.rfind(": ") + 2) + ")");
+    }
   }
   m_jobs[job->id] = job;
   if (!key.empty()) m_idempotency[key] = job->id;
@@ -251,11 +290,15 @@ double JobManager::focus_distance(const Job& job, double x, double y) {
   return pt::autofocus_distance(*scene, float(x / p.width), float(1 - y / p.height));
 }
 
-void JobManager::persist(Job& j) {
+void JobManager::write_job_file(Job& j) {
   json doc = status_json(j);
   doc["idempotency_key"] = j.idempotency_key;
+  write_file_atomic(job_dir(j.id) + "/job.json", doc.dump(1));
+}
+
+void JobManager::persist(Job& j) {
   try {
-    write_file_atomic(job_dir(j.id) + "/job.json", doc.dump(1));
+    write_job_file(j);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "render-server: job %s: %s\n", j.id.c_str(), e.what());
   }
@@ -270,9 +313,14 @@ void JobManager::load_persisted() {
     if (valid_job_id(e->d_name)) ids.push_back(e->d_name);
   closedir(d);
   std::sort(ids.begin(), ids.end());  // ids sort by creation time: the queue keeps its order
+  int temp_files = 0;
   for (const std::string& id : ids) {
+    temp_files += remove_temp_files(root + "/" + id);
     std::string text;
-    if (!read_file(root + "/" + id + "/job.json", text)) continue;
+    if (!read_file(root + "/" + id + "/job.json", text)) {
+      rmdir((root + "/" + id).c_str());  // empty: killed between mkdir and job.json (never acknowledged)
+      continue;
+    }
     try {
       json doc = json::parse(text);
       auto job = std::make_shared<Job>();
@@ -283,8 +331,10 @@ void JobManager::load_persisted() {
       JobState st = JobState::queued;
       parse_job_state(doc.value("state", "queued"), &st);
       struct stat sb;
-      bool image_ok = stat((root + "/" + id + "/image.png").c_str(), &sb) == 0 &&
-                      stat((root + "/" + id + "/image.exr").c_str(), &sb) == 0;
+      auto present = [&](const char* name) {
+        return stat((root + "/" + id + "/" + name).c_str(), &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0;
+      };
+      bool image_ok = present("image.png") && present("image.exr");
       if (st == JobState::running || (st == JobState::done && !image_ok)) st = JobState::queued;  // interrupted: run again
       job->state = st;
       if (st != JobState::queued) {
@@ -314,6 +364,7 @@ void JobManager::load_persisted() {
       std::fprintf(stderr, "render-server: skipping %s/%s/job.json: %s\n", root.c_str(), id.c_str(), e.what());
     }
   }
+  if (temp_files > 0) std::fprintf(stderr, "render-server: removed %d temp files an earlier run left\n", temp_files);
 }
 
 void JobManager::worker_loop() {
@@ -480,8 +531,14 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
                       {"pathtracer:error_estimate", std::to_string(session.error_estimate())},
                       {"pathtracer:seed", std::to_string(p.seed)},
                       {"pathtracer:nonfinite_samples", std::to_string(session.stats().nonfinite)}};
-    pt::write_image(img, job_dir(job->id) + "/image.exr", meta);
-    pt::write_image(img, job_dir(job->id) + "/image.png");
+    try {
+      pt::write_image(img, job_dir(job->id) + "/image.exr", meta);
+      pt::write_image(img, job_dir(job->id) + "/image.png");
+    } catch (const std::exception& e) {  // a full disk or a vanished data directory: the job fails, saying so
+      std::string why = e.what(), dir = job_dir(job->id) + "/";
+      for (size_t at; (at = why.find(dir)) != std::string::npos;) why.erase(at, dir.size());  // no server paths
+      throw std::runtime_error("cannot store the finished image: " + why);
+    }
     std::lock_guard<std::mutex> lock(job->mutex);
     job->state = JobState::done;
     job->progress = 1;

@@ -95,7 +95,8 @@ class JobManager {
  private:
   void worker_loop();
   void run_job(const std::shared_ptr<Job>& job);
-  void persist(Job& job);  // job.mutex must be held
+  void persist(Job& job);         // job.mutex must be held; a failure is logged
+  void write_job_file(Job& job);  // job.mutex must be held; throws on failure
   void load_persisted();
 
   ManagerConfig m_config;

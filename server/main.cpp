@@ -3,9 +3,11 @@
 #include <signal.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <thread>
 
+#include "connection.h"
 #include "jobs.h"
 #include "routes.h"
 
@@ -24,7 +26,19 @@ const char* kUsage =
     "  --threads N       render threads per job (default: all cores)\n"
     "  --concurrency N   jobs rendering at once (default 1)\n"
     "  --max-queue N     queued jobs before new ones are refused with 429 (default 32)\n"
+    "  --token T         require 'Authorization: Bearer T' on /api (all but /api/health); also read\n"
+    "                    from the environment variable RENDER_SERVER_TOKEN. The page asks for it.\n"
+    "  --max-connections N  open connections before new ones are answered 503 (default 128)\n"
+    "  --read-timeout SEC   seconds to receive a whole request, however slowly sent (default 10)\n"
     "  -h, --help        this text\n";
+
+bool parse_seconds(const char* s, double* out) {
+  char* end;
+  double v = std::strtod(s, &end);
+  if (*s == '\0' || *end != '\0' || !(v >= 0.1 && v <= 3600)) return false;
+  *out = v;
+  return true;
+}
 
 bool parse_int(const char* s, long lo, long hi, long* out) {
   char* end;
@@ -42,6 +56,9 @@ int main(int argc, char** argv) {
   srv::ManagerConfig cfg;
   cfg.threads = int(std::max(1u, std::thread::hardware_concurrency()));
   bool scenes_given = false;
+  srv::ApiOptions api;
+  api.openapi = kOpenApiJson;
+  if (const char* t = std::getenv("RENDER_SERVER_TOKEN")) api.token = t;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto value = [&]() -> const char* {
@@ -63,6 +80,9 @@ int main(int argc, char** argv) {
     else if (a == "--threads") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.threads = int(n); }
     else if (a == "--concurrency") { const char* v = value(); if (!parse_int(v, 1, 64, &n)) bad(v); cfg.concurrency = int(n); }
     else if (a == "--max-queue") { const char* v = value(); if (!parse_int(v, 0, 100000, &n)) bad(v); cfg.max_queue = size_t(n); }
+    else if (a == "--token") api.token = value();
+    else if (a == "--max-connections") { const char* v = value(); if (!parse_int(v, 1, 10000, &n)) bad(v); api.limits.max_connections = int(n); }
+    else if (a == "--read-timeout") { const char* v = value(); if (!parse_seconds(v, &api.limits.request_timeout)) bad(v); }
     else if (a == "-h" || a == "--help") { std::printf("%s", kUsage); return 0; }
     else { std::fprintf(stderr, "render-server: unknown option '%s'\n\n%s", a.c_str(), kUsage); return 2; }
   }
@@ -75,6 +95,7 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
+  signal(SIGXFSZ, SIG_IGN);  // a file-size limit makes a write fail (a failed job), not kill the server
 
   srv::JobManager jobs(cfg);
   try {
@@ -84,15 +105,16 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  httplib::Server svr;
-  svr.new_task_queue = [] { return new httplib::ThreadPool(64); };
-  svr.set_payload_max_length(64 * 1024);
-  svr.set_read_timeout(10, 0);
+  // One thread per open connection (event streams hold theirs): the pool outnumbers the connection
+  // cap, so connections over it are answered 503 at once instead of queueing.
+  srv::GuardedServer svr(api.limits);
+  int pool = api.limits.max_connections + 16;
+  svr.new_task_queue = [pool] { return new httplib::ThreadPool(size_t(pool)); };
   svr.set_write_timeout(10, 0);
   svr.set_keep_alive_max_count(100);
   svr.set_keep_alive_timeout(1);  // an idle connection holds up a shutdown this long at most
   svr.set_tcp_nodelay(true);  // headers and body go out in two writes: without it, +40 ms (delayed ACK)
-  srv::install_routes(svr, jobs, kOpenApiJson);
+  srv::install_routes(svr, jobs, api);
   if (!svr.set_mount_point("/", web)) std::fprintf(stderr, "render-server: warning: no web page at %s\n", web.c_str());
 
   int bound = port == 0 ? svr.bind_to_any_port(host) : (svr.bind_to_port(host, int(port)) ? int(port) : -1);
@@ -101,6 +123,7 @@ int main(int argc, char** argv) {
     jobs.stop();
     return 1;
   }
+  svr.widen_backlog();
   std::printf("render-server: listening on http://%s:%d/\n", host.c_str(), bound);
   std::fflush(stdout);
 

@@ -2,6 +2,8 @@
 // stream (Server-Sent Events) with per-client tile bookkeeping so slow clients skip ahead.
 #include "routes.h"
 
+#include <strings.h>
+
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -88,6 +90,42 @@ std::string allowed_methods(const std::string& path) {
   for (const auto& [re, allow] : table)
     if (std::regex_match(path, re)) return allow;
   return "";
+}
+
+// ---- access token ----
+
+const char* const kNoToken = "this server requires a token: send 'Authorization: Bearer <token>'";
+
+// Every /api call needs the token but the liveness probe; the page itself (/) does not.
+bool needs_token(const std::string& path) {
+  return (path == "/api" || path.rfind("/api/", 0) == 0) && path != "/api/health";
+}
+
+// Compares in time that depends only on the secret's length, never on where the first difference is.
+bool same_secret(const std::string& given, const std::string& secret) {
+  volatile unsigned char diff = given.size() != secret.size();
+  for (size_t i = 0; i < secret.size(); ++i)
+    diff = diff | (unsigned char)(secret[i] ^ (i < given.size() ? given[i] : 0));
+  return diff == 0;
+}
+
+// Why a request is not authorised ("" when it is): the token comes from "Authorization: Bearer T",
+// or, on the event-stream and image URLs only (EventSource and links cannot send headers), ?token=T.
+std::string auth_failure(const httplib::Request& req, const std::string& token) {
+  static const std::regex query_ok("/api/jobs/[^/]+/(events|image\\.png|image\\.exr)");
+  if (req.has_header("Authorization")) {
+    std::string auth = req.get_header_value("Authorization");
+    if (auth.size() < 7 || strncasecmp(auth.c_str(), "Bearer ", 7) != 0)
+      return "Authorization must be 'Bearer <token>'";
+    size_t start = auth.find_first_not_of(' ', 7);
+    return same_secret(start == std::string::npos ? "" : auth.substr(start), token) ? "" : "the token is not valid";
+  }
+  if (req.has_param("token")) {
+    if (!std::regex_match(req.path, query_ok))
+      return "a token in the query is accepted only on the event-stream and image URLs; send 'Authorization: Bearer <token>'";
+    return same_secret(req.get_param_value("token"), token) ? "" : "the token is not valid";
+  }
+  return kNoToken;
 }
 
 // Runs a handler body, turning ApiError into its JSON error and anything else into a 500.
@@ -231,15 +269,60 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
 
 }  // namespace
 
-void install_routes(httplib::Server& svr, JobManager& jobs, const std::string& openapi) {
-  // httplib 0.11 reads a request body without Content-Length until the read timeout (10 s, then
-  // 400): refuse such a request at once.
-  svr.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
-    bool body_method = req.method == "POST" || req.method == "PUT" || req.method == "PATCH";
-    if (!body_method || req.has_header("Content-Length") || req.has_header("Transfer-Encoding"))
-      return httplib::Server::HandlerResponse::Unhandled;
-    send_error(res, 411, "Content-Length is required");
-    return httplib::Server::HandlerResponse::Handled;
+void install_routes(httplib::Server& svr, JobManager& jobs, const ApiOptions& options) {
+  const std::string openapi = options.openapi;
+  svr.set_payload_max_length(options.max_body);
+  // Runs after the head is read and before any body: the token first, then the body's framing.
+  svr.set_pre_routing_handler([token = options.token, max_body = options.max_body](const httplib::Request& req,
+                                                                                   httplib::Response& res) {
+    using Result = httplib::Server::HandlerResponse;
+    // Methods whose body httplib reads (PRI: an HTTP/2 preface, read to the end of the connection).
+    bool body_method = req.method == "POST" || req.method == "PUT" || req.method == "PATCH" || req.method == "PRI";
+    auto refuse = [&](int status, const std::string& message) {
+      send_error(res, status, message);
+      if (body_method || req.has_header("Content-Length") || req.has_header("Transfer-Encoding")) {
+        close_after_response();  // the body stays unread: it must not be parsed as the next request
+        res.set_header("Connection", "close");
+      }
+      return Result::Handled;
+    };
+    // "/index.html%00.js" would open index.html: C file APIs stop at the NUL.
+    if (req.path.find('\0') != std::string::npos) return refuse(400, "the path contains a NUL byte");
+    if (!token.empty() && needs_token(req.path)) {
+      std::string why = auth_failure(req, token);
+      if (!why.empty()) {
+        res.set_header("WWW-Authenticate", why == kNoToken ? "Bearer realm=\"render-server\""
+                                                           : "Bearer realm=\"render-server\", error=\"invalid_token\"");
+        return refuse(401, why);
+      }
+    }
+    // One Content-Length of digits only: two that disagree, or "-1", would let a proxy in front and
+    // this server split the stream into different requests (request smuggling).
+    if (req.has_header("Content-Length")) {
+      std::string len = req.get_header_value("Content-Length");
+      if (req.get_header_value_count("Content-Length") != 1 || len.empty() || len.size() > 19 ||
+          len.find_first_not_of("0123456789") != std::string::npos)
+        return refuse(400, "Content-Length must be one non-negative integer");
+      // Refused before a byte of it is read (httplib would read and discard it all first).
+      if (std::stoull(len) > max_body)
+        return refuse(413, "the request body exceeds the limit of " + std::to_string(max_body / 1024) + " KiB");
+    }
+    if (!body_method) {
+      // httplib never reads a GET's (or HEAD's, OPTIONS') body: close after answering rather than
+      // parse it as the next request.
+      if (req.has_header("Transfer-Encoding") || (req.has_header("Content-Length") && req.method != "DELETE" &&
+                                                  req.get_header_value("Content-Length") != "0")) {
+        close_after_response();
+        res.set_header("Connection", "close");
+      }
+      return Result::Unhandled;
+    }
+    // httplib 0.11 reads a chunked body whole, past the 64 KiB payload limit: only Content-Length
+    // framing is accepted. Without either it would wait for the read timeout: refuse at once.
+    if (req.has_header("Transfer-Encoding"))
+      return refuse(411, "Transfer-Encoding is not accepted: send the body with a Content-Length");
+    if (!req.has_header("Content-Length")) return refuse(411, "Content-Length is required");
+    return Result::Unhandled;
   });
 
   svr.Get("/api/health", [&](const httplib::Request&, httplib::Response& res) {
@@ -369,7 +452,21 @@ void install_routes(httplib::Server& svr, JobManager& jobs, const std::string& o
     });
   });
 
-  svr.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+  svr.set_error_handler([limits = options.limits, max_body = options.max_body](const httplib::Request& req,
+                                                                              httplib::Response& res) {
+    // httplib answers 400 (413 for a Content-Length over the limit) when reading a request fails:
+    // say why where the connection layer knows.
+    ReadFailure failure = current_read_failure();
+    if (failure == ReadFailure::timeout && res.status == 400) {
+      char msg[120];
+      std::snprintf(msg, sizeof msg, "the request was not received within %g s", limits.request_timeout);
+      send_error(res, 408, msg);
+    } else if (failure == ReadFailure::head_too_large && res.status == 400) {
+      send_error(res, 431, "the request line and headers exceed " + std::to_string(limits.max_head_bytes) + " bytes");
+    } else if (failure == ReadFailure::body_too_large && (res.status == 400 || res.status == 413)) {
+      send_error(res, 413, "the request body exceeds the limit of " + std::to_string(max_body / 1024) + " KiB");
+    }
+    if (ends_connection(res.status)) res.set_header("Connection", "close");
     if (!res.body.empty()) return;  // a handler already wrote its JSON error
     std::string allow = res.status == 404 ? allowed_methods(req.path) : "";
     if (!allow.empty()) {

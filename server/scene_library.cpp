@@ -64,6 +64,11 @@ std::string SceneLibrary::resolve(const std::string& name) const {
 std::shared_ptr<const pt::SceneDesc> SceneLibrary::load(const std::string& name) {
   std::string path = resolve(name);
   if (path.empty()) throw ApiError(404, "unknown scene '" + name + "'", "scene");
+  // Checked before reading: the whole file is held in memory while it parses.
+  struct stat st;
+  if (stat(path.c_str(), &st) == 0 && size_t(st.st_size) > pt::LoadLimits().max_file_bytes)
+    throw pt::SceneError(name + ".dae: " + std::to_string(st.st_size) + " bytes, over the limit of " +
+                         std::to_string(pt::LoadLimits().max_file_bytes));
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();

@@ -45,15 +45,59 @@ function randomKey() {
   return Array.from({ length: 4 }, () => Math.random().toString(36).slice(2, 10)).join('-');
 }
 
+// ---------- access token (a server started with --token) ----------
+
+// Read once from the address's fragment (#token=...; a fragment never reaches a server or its
+// logs), then kept for this tab in sessionStorage and taken out of the address bar. When the
+// server answers 401 the page asks for it.
+const TOKEN_KEY = 'render-server-token';
+let token = (() => {
+  const m = location.hash.match(/(?:^#|&)token=([^&]*)/);
+  if (!m) return sessionStorage.getItem(TOKEN_KEY) || '';
+  const t = decodeURIComponent(m[1]);
+  sessionStorage.setItem(TOKEN_KEY, t);
+  const rest = location.hash.slice(1).split('&').filter((kv) => !kv.startsWith('token=')).join('&');
+  history.replaceState(null, '', location.pathname + location.search + (rest ? `#${rest}` : ''));
+  return t;
+})();
+
+function authHeaders(headers = {}) {
+  return token ? { ...headers, Authorization: `Bearer ${token}` } : headers;
+}
+
+// EventSource and links cannot send a header: the server takes the token from their query instead.
+function withToken(url) {
+  if (!token || !url) return url;
+  return `${url}${url.includes('?') ? '&' : '?'}token=${encodeURIComponent(token)}`;
+}
+
+// Asks for the token once, however many requests were refused together. Resolves true when one was given.
+let tokenPrompt = null;
+function askToken() {
+  if (!tokenPrompt) {
+    tokenPrompt = new Promise((resolve) => setTimeout(() => {
+      const t = window.prompt(token ? 'The access token was refused. Token:' : 'This render server needs an access token:', '');
+      if (t && t.trim()) {
+        token = t.trim();
+        sessionStorage.setItem(TOKEN_KEY, token);
+      }
+      resolve(Boolean(t && t.trim()));
+      setTimeout(() => { tokenPrompt = null; }, 1000);  // a burst of 401s gets one prompt
+    }, 0));
+  }
+  return tokenPrompt;
+}
+
 // fetch + JSON. Resolves {ok, status, data}; resolves null when the server cannot be reached.
-async function api(path, options = {}) {
+async function api(path, options = {}, retried = false) {
   let res;
   try {
-    res = await fetch(path, { cache: 'no-store', ...options });
+    res = await fetch(path, { cache: 'no-store', ...options, headers: authHeaders(options.headers) });
   } catch (e) {
     connectionLost();
     return null;
   }
+  if (res.status === 401 && !retried && await askToken()) return api(path, options, true);
   let data = null;
   const type = res.headers.get('Content-Type') || '';
   if (type.includes('application/json')) {
@@ -190,7 +234,7 @@ class Feed {
   }
 
   openStream() {
-    const es = new EventSource(`/api/jobs/${this.id}/events`);
+    const es = new EventSource(withToken(`/api/jobs/${this.id}/events`));
     this.es = es;
     let hadError = false;
     es.onopen = () => {
@@ -261,7 +305,7 @@ class Feed {
 
   async loadStoredImage() {
     try {
-      const res = await fetch(`/api/jobs/${this.id}/image.png`, { cache: 'no-store' });
+      const res = await fetch(`/api/jobs/${this.id}/image.png`, { cache: 'no-store', headers: authHeaders() });
       if (!res.ok) return;
       const bmp = await createImageBitmap(await res.blob(), { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
       this.setSize(bmp.width, bmp.height);
@@ -434,7 +478,7 @@ const viewer = {
 
 function setLink(a, href, name) {
   if (href) {
-    a.href = href;
+    a.href = withToken(href);
     a.download = name;
     a.removeAttribute('aria-disabled');
   } else {

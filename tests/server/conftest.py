@@ -31,3 +31,10 @@ def servers(tmp_path, contract):
 @pytest.fixture
 def server(servers):
     return servers()
+
+
+def pytest_terminal_summary(terminalreporter):
+    # The figures docs/reliability.md quotes: how many requests the tests sent, how many got a 5xx.
+    from support import STATS
+    terminalreporter.write_line(f"render-server requests sent: {STATS['requests']}, 5xx answers: {STATS['5xx']} "
+                                f"(500 Internal Server Error: {STATS['500']})")

@@ -101,7 +101,7 @@ class Contract:
         if op is None:  # no such endpoint, or a method the path does not take
             if not path.startswith("/api/"):
                 return
-            assert resp.status_code in (400, 404, 405, 411, 413, 414), what
+            assert resp.status_code in (400, 401, 404, 405, 408, 411, 413, 414, 431, 503), what
             assert media == "application/json", f"{what}: Content-Type {media!r}"
         else:
             documented = op["responses"]
@@ -121,15 +121,30 @@ class Contract:
             self.validate(body, documented[str(resp.status_code)]["content"]["application/json"]["schema"], what)
 
 
+# Requests sent and server errors seen by this process (5xx: all, deliberate 503 / 507 included;
+# 500: internal errors, which must never happen); conftest prints them at the end.
+STATS = {"requests": 0, "5xx": 0, "500": 0}
+
+
+def count_answer(status):
+    STATS["requests"] += 1
+    if status is not None and status >= 500:
+        STATS["5xx"] += 1
+        STATS["500"] += status == 500
+
+
 # ---- the HTTP client: every answer goes through the contract ----
 class Api:
-    def __init__(self, base, contract):
+    def __init__(self, base, contract, token=None):
         self.base = base
         self.contract = contract
         self.session = requests.Session()
+        if token is not None:
+            self.session.headers["Authorization"] = f"Bearer {token}"
 
     def request(self, method, path, expect=None, timeout=15, **kw):
         resp = self.session.request(method, self.base + path, timeout=timeout, **kw)
+        count_answer(resp.status_code)
         self.contract.check_response(method, path, resp)
         if expect is not None:
             assert resp.status_code == expect, f"{method} {path}: {resp.status_code} {resp.text[:400]}"
@@ -173,8 +188,14 @@ class Api:
 
 # ---- a real server process ----
 class Server:
-    def __init__(self, root, contract, threads=1, args=(), scenes=None):
+    """`token`: started with --token and its Api sends it; `env`: extra environment; `limit_file_kib`:
+    the process may write files of at most that size (ulimit -f: a disk that fills up)."""
+
+    def __init__(self, root, contract, threads=1, args=(), scenes=None, token=None, env=None, limit_file_kib=None):
         self.root = Path(root)
+        self.token = token
+        self.env = env
+        self.limit_file_kib = limit_file_kib
         self.data = self.root / "data"
         self.scenes = Path(scenes) if scenes else self.root / "scenes"
         self.contract = contract
@@ -188,9 +209,14 @@ class Server:
     def start(self, timeout=15):
         cmd = [str(RENDER_SERVER), "--port", "0", "--data", str(self.data), "--scenes", str(self.scenes),
                "--threads", str(self.threads), *self.args]
+        if self.token is not None:
+            cmd += ["--token", self.token]
+        if self.limit_file_kib is not None:  # bash sets the limit, then becomes the server (same pid)
+            cmd = ["bash", "-c", f'ulimit -f {int(self.limit_file_kib)} && exec "$0" "$@"', *cmd]
+        env = dict(os.environ, **self.env) if self.env else None
         self.log_path = self.root / f"server-{len(list(self.root.glob('server-*.log'))) + 1}.log"
         self.log = open(self.log_path, "wb")
-        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, cwd=self.root)
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, cwd=self.root, env=env)
         line = b""
         deadline = time.monotonic() + timeout
         while not line.endswith(b"\n"):
@@ -204,7 +230,7 @@ class Server:
         assert m, f"unexpected first line {line!r}"
         self.port = int(m[1])
         self.url = f"http://127.0.0.1:{self.port}"
-        self.api = Api(self.url, self.contract)
+        self.api = Api(self.url, self.contract, self.token)
         return self
 
     def log_text(self):
@@ -229,7 +255,14 @@ class Server:
             self.log.close()
 
     def events(self, job_id, **kw):
-        return EventStream(self.port, job_id, self.contract, **kw)
+        return EventStream(self.port, job_id, self.contract, token=self.token, **kw)
+
+    def rss_kib(self, field="VmRSS"):
+        """The server's resident memory (VmRSS), or its peak so far (field="VmHWM"), in KiB."""
+        for line in open(f"/proc/{self.proc.pid}/status"):
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+        return None
 
 
 # ---- Server-Sent Events ----
@@ -247,14 +280,17 @@ EVENT_SCHEMAS = {"image": "ImageEvent", "status": "StatusEvent", "tile": "TileEv
 class EventStream:
     """One watcher of /api/jobs/{id}/events; every event's data is checked against its schema."""
 
-    def __init__(self, port, job_id, contract, last_event_id=None, timeout=15):
+    def __init__(self, port, job_id, contract, last_event_id=None, timeout=15, token=None):
         self.contract = contract
         self.conn = http.client.HTTPConnection("127.0.0.1", port, timeout=timeout)
         headers = {"Accept": "text/event-stream"}
         if last_event_id is not None:
             headers["Last-Event-ID"] = str(last_event_id)
-        self.conn.request("GET", f"/api/jobs/{job_id}/events", headers=headers)
+        # As a browser's EventSource must: the token in the query, not a header.
+        query = f"?token={token}" if token is not None else ""
+        self.conn.request("GET", f"/api/jobs/{job_id}/events{query}", headers=headers)
         self.resp = self.conn.getresponse()
+        count_answer(self.resp.status)
         self.status = self.resp.status
         self.content_type = self.resp.getheader("Content-Type", "")
         self.ended = False
@@ -477,22 +513,67 @@ def render_cli(spec, scene_file, out_file, threads=2):
 # ---- raw HTTP, for requests no client library would send ----
 def raw_request(port, data, timeout=10):
     """Sends bytes as they are; returns (status, headers dict, body bytes) of the answer."""
-    with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
-        s.sendall(data)
-        buf = b""
-        while b"\r\n\r\n" not in buf:
-            chunk = s.recv(65536)
-            if not chunk:
-                break
-            buf += chunk
-        head, _, body = buf.partition(b"\r\n\r\n")
+    with RawConnection(port, timeout) as conn:
+        conn.send(data)
+        return conn.answer()
+
+
+class RawConnection:
+    """A socket to the server that sends bytes as they are and reads answers one at a time."""
+
+    def __init__(self, port, timeout=10):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+        self.buf = b""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def send(self, data):
+        self.sock.sendall(data)
+
+    def _fill(self):
+        try:
+            chunk = self.sock.recv(65536)
+        except ConnectionResetError:
+            chunk = b""
+        self.buf += chunk
+        return bool(chunk)
+
+    def answer(self):
+        """The next answer: (status, headers dict, body bytes), or (None, {}, b"") when the server
+        closed the connection without one."""
+        while b"\r\n\r\n" not in self.buf:
+            if not self._fill():
+                count_answer(None)
+                return None, {}, b""
+        head, _, self.buf = self.buf.partition(b"\r\n\r\n")
         lines = head.decode("latin-1").split("\r\n")
         status = int(lines[0].split()[1])
         headers = {k.strip().lower(): v.strip() for k, _, v in (l.partition(":") for l in lines[1:])}
         length = int(headers.get("content-length", "0"))
-        while len(body) < length:
-            chunk = s.recv(65536)
-            if not chunk:
-                break
-            body += chunk
+        while len(self.buf) < length and self._fill():
+            pass
+        body, self.buf = self.buf[:length], self.buf[length:]
+        count_answer(status)
         return status, headers, body
+
+    def closed_by_server(self, timeout):
+        """True when the server closes the connection within `timeout` seconds (bytes it sends
+        before closing are kept for answer())."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            self.sock.settimeout(max(0.01, deadline - time.monotonic()))
+            try:
+                if not self._fill():
+                    return True
+            except socket.timeout:
+                return False
+            except OSError:
+                return True
+        return False
+
+    def close(self):
+        self.sock.close()

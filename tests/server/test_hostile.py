@@ -2,11 +2,12 @@
 the offending field where there is one; afterwards the server is healthy and still renders."""
 import json
 import os
+import socket
 import time
 
 import pytest
 
-from support import CORNELL, TINY, Server, raw_request
+from support import CORNELL, TINY, RawConnection, Server, raw_request
 
 INT_FIELDS = ["max_depth", "spp", "light_samples", "width", "height", "seed", "adaptive_batch", "tile_size"]
 NUM_FIELDS = ["aperture", "focal_distance", "adaptive_tolerance", "time_limit", "target_error"]
@@ -171,6 +172,122 @@ def test_overlong_uri_is_414(srv, contract):
     status, headers, body = raw_request(
         srv.port, b"GET /api/jobs/" + b"a" * 10000 + b" HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
     check_raw_error(contract, status, headers, body, 414)
+
+
+# ---- raw requests: malformed request lines, headers and framing, truncations, pipelining ----
+H = b"Host: 127.0.0.1\r\n"
+CHECK = b"POST /api/jobs/check HTTP/1.1\r\n" + H + b"Content-Type: application/json\r\n"
+VALID = json.dumps({"scene": "cornell", "width": 8, "height": 8, "spp": 1}).encode()
+# (name, bytes, status: an int, or None for "closed without an answer"). A refused request closes
+# its connection (its unread bytes must not be parsed as a next request): checked for every 4xx here.
+RAW = [
+    ("lower-case method", b"get /api/health HTTP/1.1\r\n" + H + b"\r\n", 400),
+    ("unknown method", b"FOO /api/health HTTP/1.1\r\n" + H + b"\r\n", 400),
+    ("TRACE", b"TRACE /api/health HTTP/1.1\r\n" + H + b"\r\n", 400),
+    ("CONNECT", b"CONNECT 127.0.0.1:80 HTTP/1.1\r\n" + H + b"\r\n", 400),
+    ("HTTP/2.0 preface", b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n", 400),
+    ("HTTP/2.0 version", b"GET /api/health HTTP/2.0\r\n" + H + b"\r\n", 400),
+    ("HTTP/1.2 version", b"GET /api/health HTTP/1.2\r\n" + H + b"\r\n", 400),
+    ("HTTP/0.9 (no version)", b"GET /api/health\r\n\r\n", 400),
+    ("tab separator", b"GET\t/api/health HTTP/1.1\r\n" + H + b"\r\n", 400),
+    ("empty request line", b"\r\n", 400),
+    ("NUL in the request line", b"GET /api/he\x00alth HTTP/1.1\r\n" + H + b"\r\n", 400),
+    ("bare LF line ends", b"GET /api/health HTTP/1.1\nHost: x\n\n", 400),
+    ("binary garbage", bytes(range(256)) + b"\r\n\r\n", 400),
+    ("header line over 8 KiB", b"GET /api/health HTTP/1.1\r\nX-A: " + b"a" * 9000 + b"\r\n" + H + b"\r\n", 400),
+    ("1500 headers (over 16 KiB)",
+     b"GET /api/health HTTP/1.1\r\n" + b"".join(b"X-%d: aaaaaaaaaa\r\n" % i for i in range(1500)) + H + b"\r\n", 431),
+    ("one 15 KiB header of many short values", b"GET /api/health HTTP/1.1\r\n" + b"X-A: b\r\n" * 2400 + b"\r\n", 431),
+    ("Content-Length -1", CHECK + b"Content-Length: -1\r\n\r\n{}", 400),
+    ("Content-Length not a number", CHECK + b"Content-Length: abc\r\n\r\n{}", 400),
+    ("Content-Length with a sign", CHECK + b"Content-Length: +2\r\n\r\n{}", 400),
+    ("Content-Length 20 digits", CHECK + b"Content-Length: 99999999999999999999\r\n\r\n{}", 400),
+    ("two Content-Lengths (smuggling)", CHECK + b"Content-Length: 2\r\nContent-Length: 20\r\n\r\n{}", 400),
+    ("Content-Length over 64 KiB, body never sent", CHECK + b"Content-Length: 99999999999999999\r\n\r\n", 413),
+    ("Content-Length over 64 KiB, 100 KB sent", CHECK + b"Content-Length: 100000\r\n\r\n" + b"x" * 100000, 413),
+    ("chunked body", CHECK + b"Transfer-Encoding: chunked\r\n\r\n2\r\n{}\r\n0\r\n\r\n", 411),
+    ("chunked and Content-Length", CHECK + b"Content-Length: 2\r\nTransfer-Encoding: chunked\r\n\r\n{}", 411),
+    ("gzip, chunked", CHECK + b"Transfer-Encoding: gzip, chunked\r\n\r\n0\r\n\r\n", 411),
+    ("absolute-form target", b"GET http://127.0.0.1/api/health HTTP/1.1\r\n" + H + b"\r\n", 404),
+    ("asterisk-form target", b"OPTIONS * HTTP/1.1\r\n" + H + b"\r\n", 404),
+    ("JSON nested 30000 deep", CHECK + b"Content-Length: 60000\r\n\r\n" + b"[" * 30000 + b"]" * 30000, 400),
+    ("object nested 5000 deep", CHECK + b"Content-Length: 35001\r\n\r\n" + b'{"a":' * 5000 + b"1" + b"}" * 5000, 400),
+    ("3000 unknown keys", CHECK + b"Content-Length: %d\r\n\r\n" % (len(json.dumps({f"k{i}": i for i in range(3000)}))) +
+     json.dumps({f"k{i}": i for i in range(3000)}).encode(), 400),
+    ("lone surrogate", CHECK + b'Content-Length: 20\r\n\r\n{"scene": "\\ud800"}', 400),
+    ("raw control character in a string", CHECK + b'Content-Length: 18\r\n\r\n{"scene": "a\x01b"}', 400),
+    ("UTF-16 body", CHECK + b"Content-Length: %d\r\n\r\n" % len(VALID.decode().encode("utf-16")) +
+     VALID.decode().encode("utf-16"), 400),
+    ("body shorter than Content-Length, then EOF", CHECK + b"Content-Length: 100\r\n\r\n{\"scene\"", 400),
+    ("head cut off, then EOF", b"GET /api/health HTTP/1.1\r\nHost: x", 400),
+    ("request line only, then EOF", b"GET /api/health HTTP/1.1\r\n", 400),
+    ("half a request line, then EOF", b"GET /api/hea", 400),
+    ("nothing, then EOF", b"", None),
+]
+
+
+@pytest.mark.parametrize("name,data,status", RAW, ids=[r[0] for r in RAW])
+def test_raw_request_is_refused(srv, contract, name, data, status):
+    with RawConnection(srv.port) as conn:
+        conn.send(data)
+        conn.sock.shutdown(socket.SHUT_WR)  # everything is sent: truncated requests end here
+        got, headers, body = conn.answer()
+        assert got == status, body[:300]
+        if status is not None and status >= 400 and status != 404:
+            check_raw_error(contract, got, headers, body, status)
+            assert headers.get("connection") == "close"
+        assert conn.closed_by_server(2), "the server kept a refused connection open"
+
+
+# (name, bytes, statuses of the answers in order; None: the connection then closed)
+ACCEPTED = [
+    ("two spaces after the method", b"GET  /api/health HTTP/1.1\r\n" + H + b"\r\n", [200]),
+    ("header without a colon", b"GET /api/health HTTP/1.1\r\nFoo\r\n" + H + b"\r\n", [200]),
+    ("obsolete line folding", b"GET /api/health HTTP/1.1\r\nX-A: 1\r\n  folded\r\n" + H + b"\r\n", [200]),
+    ("NUL in a header value", b"GET /api/health HTTP/1.1\r\nX-A: a\x00b\r\n" + H + b"\r\n", [200]),
+    ("HTTP/1.0 without Host", b"GET /api/health HTTP/1.0\r\n\r\n", [200, None]),
+    ("HEAD", b"HEAD /api/health HTTP/1.1\r\n" + H + b"\r\n", [200]),
+    ("HEAD of an unknown job", b"HEAD /api/jobs/0123456789abcdef HTTP/1.1\r\n" + H + b"\r\n", [404]),
+    ("CRLF smuggled into a job id", b"GET /api/jobs/x%0d%0aSet-Cookie:%20a=b HTTP/1.1\r\n" + H + b"\r\n", [404]),
+    ("two pipelined requests", b"GET /api/health HTTP/1.1\r\n" + H + b"\r\nGET /api/jobs HTTP/1.1\r\n" + H + b"\r\n",
+     [200, 200]),
+    ("a request, then garbage", b"GET /api/health HTTP/1.1\r\n" + H + b"\r\nxyz\r\n\r\n", [200, 400, None]),
+    ("GET with a body: answered, then closed", b"GET /api/health HTTP/1.1\r\n" + H +
+     b"Content-Length: 5\r\n\r\nhelloGET /api/health HTTP/1.1\r\n\r\n", [200, None]),
+    ("Expect: 100-continue", CHECK + b"Expect: 100-continue\r\nContent-Length: %d\r\n\r\n" % len(VALID) + VALID,
+     [100, 200]),
+    ("UTF-8 byte order mark", CHECK + b"Content-Length: %d\r\n\r\n\xef\xbb\xbf" % (len(VALID) + 3) + VALID, [200]),
+    ("DELETE with a body", b"DELETE /api/jobs/0123456789abcdef HTTP/1.1\r\n" + H + b"Content-Length: 5\r\n\r\nhello",
+     [404]),
+    ("query of 2000 parameters", b"GET /api/jobs?" + b"a=1&" * 2000 + b" HTTP/1.1\r\n" + H + b"\r\n", [200]),
+    ("bad percent-escapes in the query", b"GET /api/jobs?x=%zz&%=%%&y HTTP/1.1\r\n" + H + b"\r\n", [200]),
+]
+
+
+@pytest.mark.parametrize("name,data,statuses", ACCEPTED, ids=[r[0] for r in ACCEPTED])
+def test_odd_but_valid_request(srv, name, data, statuses):
+    with RawConnection(srv.port) as conn:
+        conn.send(data)
+        for status in statuses:
+            got, headers, body = conn.answer()
+            assert got == status, (got, body[:300])
+            assert "set-cookie" not in headers
+        if statuses[-1] is None:
+            assert conn.closed_by_server(2)
+
+
+# Static files (the page): nothing outside web/ is ever served.
+TRAVERSAL = ["/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd", "/..%2f..%2fetc%2fpasswd", "//etc/passwd",
+             "/web/../server/main.cpp", "/../server/main.cpp", "/%2e%2e%2fserver%2fmain.cpp", "/index.html%00.js",
+             "/.%2e/.%2e/etc/passwd", "/....//....//etc/passwd", "/%252e%252e/etc/passwd", "/app.js/..%5c..%5cREADME.md",
+             "/./../README.md", "/api/../../etc/passwd", "/\\..\\..\\etc\\passwd"]
+
+
+@pytest.mark.parametrize("path", TRAVERSAL)
+def test_path_traversal_serves_nothing_outside_web(srv, path):
+    status, headers, body = raw_request(srv.port, b"GET " + path.encode() + b" HTTP/1.1\r\n" + H + b"\r\n")
+    assert status in (400, 404), (status, body[:200])  # "%00": 400, not index.html
+    assert b"root:" not in body and b"#include" not in body and b"render-job" not in body.lower()
 
 
 UNKNOWN = "0123456789abcdef"
