@@ -68,6 +68,7 @@ int main(int argc, char** argv) {
     auto scene = make_render_scene(desc, o.params);
     double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.describe) return describe_scene(o, desc, *scene, load_s);
+    desc = SceneDesc();  // the render scene holds what rendering reads: drop the file's copy
     if (!o.quiet)
       std::fprintf(stderr, "Loaded %s: %zu triangles, %zu spheres, %zu lights in %.3f s\n", o.scene_path.c_str(),
                    scene->triangle_count, scene->sphere_count, scene->lights.size(), load_s);
