@@ -98,6 +98,8 @@ int remove_temp_files(const std::string& dir) {
   return removed;
 }
 
+}  // namespace
+
 bool read_file(const std::string& path, std::string& out) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return false;
@@ -106,8 +108,6 @@ bool read_file(const std::string& path, std::string& out) {
   out = ss.str();
   return true;
 }
-
-}  // namespace
 
 const char* job_state_name(JobState s) {
   switch (s) {

@@ -17,6 +17,9 @@
 
 namespace srv {
 
+// Reads a whole file (job images, job.json); false when it cannot be opened.
+bool read_file(const std::string& path, std::string& out);
+
 enum class JobState { queued, running, done, failed, cancelled };
 const char* job_state_name(JobState s);
 bool parse_job_state(const std::string& s, JobState* out);

@@ -57,15 +57,6 @@ std::string base64(const std::string& in) {
   return out;
 }
 
-bool read_file(const std::string& path, std::string& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  out = ss.str();
-  return true;
-}
-
 json parse_body(const httplib::Request& req) {
   std::string ct = req.get_header_value("Content-Type");
   for (char& c : ct) c = char(std::tolower((unsigned char)c));  // media types are case-insensitive
