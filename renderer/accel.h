@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -67,12 +68,43 @@ struct RayRecorder {
 // default) it costs one thread-local pointer test per query.
 void record_rays_on_this_thread(RayRecorder* r);
 
-// A ray leaving the surface in direction d, origin pushed off to the side d points to.
 // Offsets follow Waechter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
-// Ray Tracing Gems ch. 6 (2019), so they scale with the hit's coordinates.
-Ray spawn_ray(const SurfaceHit& hit, Vec3 d);
+// Ray Tracing Gems ch. 6 (2019), so they scale with the hit's coordinates: an integer ULP offset
+// away from the surface, a float offset near the origin. Inline: every bounce and shadow ray
+// passes here.
+inline float offset_ray_coordinate(float p, float n) {
+  constexpr float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
+  int32_t of = int32_t(int_scale * n);
+  int32_t bits;
+  std::memcpy(&bits, &p, 4);
+  bits += p < 0 ? -of : of;
+  float moved;
+  std::memcpy(&moved, &bits, 4);
+  return std::fabs(p) < origin ? p + float_scale * n : moved;
+}
+inline Vec3 offset_ray_origin(Vec3 p, Vec3 n) {
+  return {offset_ray_coordinate(p.x, n.x), offset_ray_coordinate(p.y, n.y), offset_ray_coordinate(p.z, n.z)};
+}
+
+// A ray leaving the surface in direction d, origin pushed off to the side d points to.
+inline Ray spawn_ray(const SurfaceHit& hit, Vec3 d) {
+  Vec3 n = dot(d, hit.ng) >= 0 ? hit.ng : -hit.ng;
+  Ray r;
+  r.o = offset_ray_origin(hit.p + n * hit.offset, n);
+  r.d = d;
+  r.tmin = 0;
+  r.tmax = kInf;
+  return r;
+}
 // A shadow ray from the surface to a point on another surface (target excluded).
-Ray spawn_ray_to(const SurfaceHit& hit, Vec3 target);
-Vec3 offset_ray_origin(Vec3 p, Vec3 n);
+inline Ray spawn_ray_to(const SurfaceHit& hit, Vec3 target) {
+  Vec3 n = dot(target - hit.p, hit.ng) >= 0 ? hit.ng : -hit.ng;
+  Ray r;
+  r.o = offset_ray_origin(hit.p + n * hit.offset, n);
+  r.d = target - r.o;
+  r.tmin = 0;
+  r.tmax = 1 - 1e-4f;  // stop short of the target surface itself
+  return r;
+}
 
 }  // namespace pt

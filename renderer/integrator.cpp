@@ -167,7 +167,10 @@ Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray,
                                             : direct_light_sampling<F>(scene, params, v, rng, rays));
 
     BsdfSample bs;
-    float u_lobe = rng.next_float();
+    // Only glass and refraction choose a lobe; other materials skip that draw unevaluated.
+    float u_lobe = 0;
+    if (transmissive) u_lobe = rng.next_float();
+    else rng.skip_1d();
     Vec2 u = rng.next_2d();
     if (!sample_f<F>(material, v.wo, u_lobe, u, bs)) break;
     Vec3 wi_world = v.frame.to_world(bs.wi);
