@@ -22,8 +22,7 @@ void set_basis(Camera& c, Vec3 back, Vec3 up_hint) {
 }
 
 // The authored field of view, horizontal and vertical, in radians.
-void file_fov(const SceneDesc& scene, float* h_fov, float* v_fov) {
-  const CameraDesc& cd = scene.camera;
+void file_fov(const CameraDesc& cd, float* h_fov, float* v_fov) {
   float xf = cd.xfov_deg * kDeg, yf = cd.yfov_deg * kDeg;
   if (!cd.present) {
     xf = 50 * kDeg;
@@ -68,6 +67,10 @@ void read_settings_file(Camera& c, const std::string& path) {
 }  // namespace
 
 Camera make_camera(const SceneDesc& scene, const CameraParams& p) {
+  return make_camera(scene.camera, scene.geometry_bounds(), p);
+}
+
+Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraParams& p) {
   Camera c;
   c.width = p.width;
   c.height = p.height;
@@ -76,37 +79,36 @@ Camera make_camera(const SceneDesc& scene, const CameraParams& p) {
 
   if (!p.settings_file.empty()) {
     read_settings_file(c, p.settings_file);
-  } else if (p.file_camera && scene.camera.present) {
-    const Mat4& m = scene.camera.world;
+  } else if (p.file_camera && authored.present) {
+    const Mat4& m = authored.world;
     c.position = m.point(Vec3(0, 0, 0));
     Vec3 r = m.vector(Vec3(1, 0, 0)), u = m.vector(Vec3(0, 1, 0));
     set_basis(c, m.vector(Vec3(0, 0, 1)), u);
     if (dot(cross(u, m.vector(Vec3(0, 0, 1))), r) < 0) c.right = -c.right;  // keep handedness as authored
     float h_fov, v_fov;
-    file_fov(scene, &h_fov, &v_fov);
+    file_fov(authored, &h_fov, &v_fov);
     // Authored horizontal FOV spans the output width; the vertical follows the output aspect.
     c.screen_distance = float(p.width) / (2 * std::tan(h_fov / 2));
-    c.tmin = scene.camera.znear;
-    c.tmax = scene.camera.zfar;
+    c.tmin = authored.znear;
+    c.tmax = authored.zfar;
     c.target = c.position - c.back;
   } else {
     // Course framing: orbit the bounding-box centre at 1.5x its diagonal, looking from the
     // direction of the camera node's matrix applied to the point (0, 0, -1); world up is +Y.
     float h_fov, v_fov;
-    file_fov(scene, &h_fov, &v_fov);
+    file_fov(authored, &h_fov, &v_fov);
     const float aspect = 800.0f / 600.0f;  // the course fits the FOV to its 800x600 screen
     if (std::tan(h_fov / 2) / std::tan(v_fov / 2) < aspect)
       h_fov = 2 * std::atan(std::tan(v_fov / 2) * aspect);
     else
       v_fov = 2 * std::atan(std::tan(h_fov / 2) / aspect);
     c.screen_distance = 600.0f / (2 * std::tan(v_fov / 2));
-    Bounds3 b = scene.geometry_bounds();
     Vec3 target = b.empty() ? Vec3(0.0f) : b.center();
     float dist = b.empty() ? 1.0f : 1.5f * length(b.diagonal());
     if (!(dist > 0)) dist = 1;
     Vec3 dir(0, 0, 1);
-    if (scene.camera.present) {
-      Vec3 d = normalize(scene.camera.world.point(Vec3(0, 0, -1)));
+    if (authored.present) {
+      Vec3 d = normalize(authored.world.point(Vec3(0, 0, -1)));
       if (!is_black(d) && is_finite(d)) dir = d;
     }
     c.target = target;

@@ -36,6 +36,9 @@ struct Camera {
 
 // Builds the camera; throws std::runtime_error naming the settings file on a bad -c file.
 Camera make_camera(const SceneDesc& scene, const CameraParams& params);
+// The same from what the camera reads of a scene: the file's camera and the geometry bounds (the
+// course framing orbits them), so a view can be made without the scene's vertices.
+Camera make_camera(const CameraDesc& authored, const Bounds3& bounds, const CameraParams& params);
 // Writes the course's six-line camera settings file (the window's D key).
 void write_camera_settings(const Camera& camera, const std::string& path);
 

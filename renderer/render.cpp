@@ -45,10 +45,9 @@ CameraParams camera_params(const RenderParams& params) {
   return cp;
 }
 
-std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
-  params.validate();
-  auto rs = std::make_unique<RenderScene>();
-  rs->materials = desc.materials;
+SceneBase make_scene_base(const SceneDesc& desc) {
+  SceneBase base;
+  base.materials = desc.materials;
   std::vector<EmitterPanel> panels;
   std::set<std::string> light_kinds;
 
@@ -81,9 +80,9 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
         em.name = ld.name + " (panel)";
         em.type = MaterialType::emission;
         em.radiance = ld.color;
-        p.material = int(rs->materials.size());
-        rs->materials.push_back(em);
-        p.light = int(rs->lights.size());
+        p.material = int(base.materials.size());
+        base.materials.push_back(em);
+        p.light = int(base.lights.size());
         panels.push_back(p);
         break;
       }
@@ -99,7 +98,7 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
       case LightType::ambient: l.kind = LightKind::ambient; break;
     }
     light_kinds.insert(light_kind_name(l.kind));
-    rs->lights.push_back(std::move(l));
+    base.lights.push_back(std::move(l));
   }
 
   // Emissive mesh triangles become one mesh light per (mesh, material), sampled by area.
@@ -109,7 +108,7 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
     std::map<int, int> light_of_material;
     for (size_t t = 0; t < mesh.tri_material.size(); ++t) {
       int mat = mesh.tri_material[t];
-      if (!is_emissive(rs->materials[mat])) continue;
+      if (!is_emissive(base.materials[mat])) continue;
       const uint32_t* vi = &mesh.indices[3 * t];
       if (!(length(cross(mesh.positions[vi[1]] - mesh.positions[vi[0]], mesh.positions[vi[2]] - mesh.positions[vi[0]])) > 0))
         continue;  // a zero-area triangle cannot emit
@@ -118,17 +117,17 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
         Light l;
         l.kind = LightKind::mesh;
         l.name = mesh.name;
-        l.color = rs->materials[mat].radiance;
-        it = light_of_material.emplace(mat, int(rs->lights.size())).first;
-        rs->lights.push_back(std::move(l));
+        l.color = base.materials[mat].radiance;
+        it = light_of_material.emplace(mat, int(base.lights.size())).first;
+        base.lights.push_back(std::move(l));
       }
-      Light& l = rs->lights[it->second];
+      Light& l = base.lights[it->second];
       for (int k = 0; k < 3; ++k) l.triangles.push_back(mesh.positions[mesh.indices[3 * t + k]]);
       if (mesh_light[mi].empty()) mesh_light[mi].assign(mesh.tri_material.size(), -1);
       mesh_light[mi][t] = it->second;
     }
   }
-  for (Light& l : rs->lights) {
+  for (Light& l : base.lights) {
     if (l.kind != LightKind::mesh) continue;
     std::vector<float> areas(l.triangles.size() / 3);
     double total = 0;
@@ -142,49 +141,91 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
     light_kinds.insert("mesh");
   }
 
-  if (!params.env_map.empty()) {
-    ImageRGB env = read_image(params.env_map);
-    rs->environment = std::make_unique<EnvironmentMap>(env.width, env.height, std::move(env.pixels));
-    Light l;
-    l.kind = LightKind::environment;
-    l.name = params.env_map;
-    l.env = rs->environment.get();
-    rs->environment_light = int(rs->lights.size());
-    rs->lights.push_back(std::move(l));
-    light_kinds.insert("environment");
-  }
-  for (size_t i = 0; i < rs->lights.size(); ++i)
-    if (rs->lights[i].kind == LightKind::ambient || rs->lights[i].kind == LightKind::environment)
-      rs->infinite_lights.push_back(int(i));
+  base.accel = std::make_shared<const Accel>(desc, panels, mesh_light);
 
-  rs->accel = std::make_unique<Accel>(desc, panels, mesh_light);
-
-  rs->camera = make_camera(desc, camera_params(params));
-
-  SceneFeatures& f = rs->features;
+  SceneFeatures& f = base.features;
   std::set<std::string> mats;
   for (const MeshDesc& m : desc.meshes)
-    for (int t : m.tri_material) mats.insert(material_type_name(rs->materials[t].type));
-  for (const SphereDesc& s : desc.spheres) mats.insert(material_type_name(rs->materials[s.material].type));
+    for (int t : m.tri_material) mats.insert(material_type_name(base.materials[t].type));
+  for (const SphereDesc& s : desc.spheres) mats.insert(material_type_name(base.materials[s.material].type));
   if (!panels.empty()) mats.insert("emission");
   f.materials.assign(mats.begin(), mats.end());
   f.lights.assign(light_kinds.begin(), light_kinds.end());
   f.spheres = !desc.spheres.empty();
   f.meshes = !desc.meshes.empty();
-  f.environment = rs->environment != nullptr;
-  f.thin_lens = params.lens_radius > 0;
-  f.adaptive = params.adaptive && params.spp > params.adaptive_batch;
   for (const MeshDesc& m : desc.meshes) f.shading_normals |= !m.normals.empty();
   f.bits = 0;
-  for (const Material& m : rs->materials) {
+  for (const Material& m : base.materials) {
     if (is_delta(m)) f.bits |= kFeatDelta;
     if (m.type == MaterialType::microfacet) f.bits |= kFeatMicrofacet;
   }
+  for (const Light& l : base.lights)
+    if (l.kind == LightKind::ambient) f.bits |= kFeatInfinite;
+  base.triangle_count = desc.triangle_count();
+  base.sphere_count = desc.spheres.size();
+  base.camera = desc.camera;
+  base.bounds = desc.geometry_bounds();
+  base.source = desc.source;
+  return base;
+}
+
+size_t SceneBase::memory_bytes() const {
+  size_t bytes = accel ? accel->memory_bytes() : 0;
+  bytes += materials.capacity() * sizeof(Material) + lights.capacity() * sizeof(Light);
+  for (const Light& l : lights)  // mesh lights: corners, and the area distribution (float + double cdf)
+    bytes += l.triangles.capacity() * sizeof(Vec3) + l.triangle_distribution.size() * (sizeof(float) + sizeof(double));
+  return bytes;
+}
+
+namespace {
+
+// A view from a base taken by value: make_render_scene moves its fresh base in, make_view copies.
+std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params) {
+  auto rs = std::make_unique<RenderScene>();
+  rs->materials = std::move(base.materials);
+  rs->lights = std::move(base.lights);
+  rs->accel = std::move(base.accel);
+  rs->triangle_count = base.triangle_count;
+  rs->sphere_count = base.sphere_count;
+  SceneFeatures& f = rs->features;
+  f = std::move(base.features);
+  if (!params.env_map.empty()) {
+    ImageRGB env = read_image(params.env_map);
+    auto map = std::make_shared<const EnvironmentMap>(env.width, env.height, std::move(env.pixels));
+    Light l;
+    l.kind = LightKind::environment;
+    l.name = params.env_map;
+    l.env = map.get();
+    rs->environment = std::move(map);
+    rs->environment_light = int(rs->lights.size());
+    rs->lights.push_back(std::move(l));
+    std::set<std::string> kinds(f.lights.begin(), f.lights.end());
+    kinds.insert("environment");
+    f.lights.assign(kinds.begin(), kinds.end());
+  }
+  for (size_t i = 0; i < rs->lights.size(); ++i)
+    if (rs->lights[i].kind == LightKind::ambient || rs->lights[i].kind == LightKind::environment)
+      rs->infinite_lights.push_back(int(i));
+  rs->camera = make_camera(base.camera, base.bounds, camera_params(params));
+
+  f.environment = rs->environment != nullptr;
+  f.thin_lens = params.lens_radius > 0;
+  f.adaptive = params.adaptive && params.spp > params.adaptive_batch;
   if (!rs->infinite_lights.empty()) f.bits |= kFeatInfinite;
   if (params.generic) f.bits = kFeatAll;
-  rs->triangle_count = desc.triangle_count();
-  rs->sphere_count = desc.spheres.size();
   return rs;
+}
+
+}  // namespace
+
+std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams& params) {
+  params.validate();
+  return view_of(base, params);
+}
+
+std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
+  params.validate();  // before the build: a bad option fails fast
+  return view_of(make_scene_base(desc), params);
 }
 
 // ---- session ----
@@ -233,7 +274,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
       while (m_count[i] < uint32_t(target)) {
         uint32_t s = m_count[i];
         if ((s & 15) == 15 && stop_requested(cancel)) break;
-        Sampler rng(p.sampler, p.seed, pixel_index, s);
+        Sampler rng(p.sampler, p.seed, pixel_index, m_first_sample + s);
         Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
         Vec2 lens = cam.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};  // a pinhole needs none
         Ray ray = cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
@@ -357,6 +398,11 @@ void RenderSession::read_tile(const Tile& t, std::vector<Vec3>& out) const {
       size_t i = size_t(y) * m_w + x;
       out.push_back(m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f));
     }
+}
+
+void RenderSession::set_sample_range(uint32_t first, const std::vector<uint8_t>& skip) {
+  m_first_sample = first;
+  for (size_t i = 0; i < skip.size() && i < m_done.size(); ++i) m_done[i] |= skip[i];
 }
 
 float autofocus_distance(const RenderScene& scene, float sx, float sy) {

@@ -60,13 +60,30 @@ struct SceneFeatures {
   uint32_t bits = kFeatAll;  // which specialised path loop runs
 };
 
+// The view-independent part of a render scene: built once per scene file and shared read-only by
+// every view of it (the server keeps one per file content). It keeps no vertex arrays of the file:
+// only the BVH and what a view needs (the file's camera and the geometry bounds).
+struct SceneBase {
+  std::vector<Material> materials;  // the file's, then one emission material per area-light panel
+  std::vector<Light> lights;        // without the environment map (that is a render option)
+  std::shared_ptr<const Accel> accel;
+  SceneFeatures features;           // what the file contains; a view adds the options' features
+  size_t triangle_count = 0, sphere_count = 0;
+  CameraDesc camera;                // what make_camera reads of the file
+  Bounds3 bounds;
+  std::string source;
+
+  // Bytes held for rendering: BVH and geometry (Accel::memory_bytes), lights, materials.
+  size_t memory_bytes() const;
+};
+
 struct RenderScene {
   std::vector<Material> materials;
   std::vector<Light> lights;
   std::vector<int> infinite_lights;  // ambient / environment, looked up when rays escape
   int environment_light = -1;        // visible to camera rays
-  std::unique_ptr<EnvironmentMap> environment;
-  std::unique_ptr<Accel> accel;
+  std::shared_ptr<const EnvironmentMap> environment;
+  std::shared_ptr<const Accel> accel;  // shared with the SceneBase and its other views
   Camera camera;
   SceneFeatures features;
   size_t triangle_count = 0, sphere_count = 0;
@@ -74,7 +91,13 @@ struct RenderScene {
 
 // Builds what the integrator needs from the file's description: lights (area lights also as
 // visible panels, emissive meshes as mesh lights), the environment map, the camera, the BVH.
+// The same as make_view(make_scene_base(desc), params).
 std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params);
+// The expensive, options-independent part: lights, materials, the BVH, the feature analysis.
+SceneBase make_scene_base(const SceneDesc& desc);
+// One view of a shared base for a set of options: the camera, the environment map, the options'
+// features. Cheap (copies materials and lights); the view shares the base's BVH.
+std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams& params);
 // The camera part of the render options (what make_render_scene passes to make_camera).
 CameraParams camera_params(const RenderParams& params);
 
@@ -129,6 +152,14 @@ class RenderSession {
   // The rate image's colours for a tile's pixels, row by row; safe where read_tile is.
   void read_tile_rate(const Tile& t, std::vector<Vec3>& out) const;
 
+  // For one share of a distributed render: sample indices start at `first` (so disjoint ranges
+  // merge into the single-machine image) and pixels whose `skip` byte is set are left out.
+  void set_sample_range(uint32_t first, const std::vector<uint8_t>& skip);
+  // Per-pixel sums of what was rendered: radiance, luminance squared, and sample counts.
+  const std::vector<Vec3>& pixel_sums() const { return m_sum; }
+  const std::vector<double>& pixel_lum2_sums() const { return m_s2; }
+  const std::vector<uint32_t>& pixel_counts() const { return m_count; }
+
  private:
   void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
                    uint64_t& samples, uint64_t& nonfinite);
@@ -137,6 +168,7 @@ class RenderSession {
   RenderParams m_params;
   int m_w, m_h;            // film size (the cell for -p)
   int m_frame_x0, m_frame_y0;  // film origin inside the full frame, top-left
+  uint32_t m_first_sample = 0;
   std::vector<Tile> m_tiles;
   std::vector<Vec3> m_sum;
   std::vector<double> m_s1, m_s2;   // luminance sums for adaptive sampling (the course's test)

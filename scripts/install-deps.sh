@@ -8,6 +8,7 @@ packages=(
   libgl1-mesa-dri xauth  # the window tests: Mesa's llvmpipe OpenGL under Xvfb
   chromium nodejs npm  # the web page's browser test (tests/web: playwright-core drives this Chromium)
   python3-venv python3-pip  # build/venv for the server tests (scripts/python-env.sh)
+  redis-server libhiredis-dev  # the scale-out queue (render-worker) and its tests
   clang libclang-rt-14-dev  # build-fuzz: libFuzzer and the sanitizer runtimes (scripts/fuzz.sh, asan.sh)
 )
 missing=()

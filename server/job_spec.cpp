@@ -146,4 +146,14 @@ json job_spec_defaults() {
   return j;
 }
 
+std::vector<std::string> feature_names(const pt::SceneFeatures& f) {
+  std::vector<std::string> out = f.materials;
+  for (const std::string& l : f.lights) out.push_back(l + " light");
+  if (f.spheres) out.push_back("spheres");
+  if (f.environment) out.push_back("environment map");
+  if (f.thin_lens) out.push_back("thin lens");
+  if (f.adaptive) out.push_back("adaptive sampling");
+  return out;
+}
+
 }  // namespace srv

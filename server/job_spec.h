@@ -43,5 +43,7 @@ json job_spec_to_json(const JobSpec& spec);
 // The defaults and limits, as the API documents them.
 json job_spec_defaults();
 bool valid_scene_name(const std::string& name);
+// The feature list a job's status shows (materials, lights, spheres, ...).
+std::vector<std::string> feature_names(const pt::SceneFeatures& f);
 
 }  // namespace srv

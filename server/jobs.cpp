@@ -13,11 +13,13 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 
 #include "collada.h"
 #include "image.h"
+#include "render_backend.h"
 
 namespace srv {
 
@@ -133,6 +135,9 @@ JobManager::JobManager(ManagerConfig config) : m_config(std::move(config)), m_sc
 
 JobManager::~JobManager() { stop(); }
 
+std::string JobManager::backend_name() const { return m_backend ? m_backend->name() : "embedded"; }
+int JobManager::live_workers() const { return m_backend ? m_backend->live_workers() : -1; }
+
 std::string JobManager::job_dir(const std::string& id) const { return m_config.data_dir + "/jobs/" + id; }
 
 void JobManager::start() {
@@ -145,6 +150,10 @@ void JobManager::start() {
   } catch (const std::exception& e) {
     throw std::runtime_error("data directory '" + m_config.data_dir + "' is not writable (" + e.what() + ")");
   }
+  if (m_config.queue.empty() || m_config.queue == "embedded")
+    m_backend = make_embedded_backend(m_scenes, m_config.threads);
+  else
+    m_backend = make_redis_backend(m_scenes, m_config.queue, m_config.units_in_flight);
   load_persisted();
   for (int i = 0; i < std::max(1, m_config.concurrency); ++i) m_workers.emplace_back([this] { worker_loop(); });
 }
@@ -284,9 +293,9 @@ double JobManager::focus_distance(const Job& job, double x, double y) {
   std::string size = std::to_string(p.width) + "x" + std::to_string(p.height);
   if (!(x >= 0 && x <= p.width)) throw ApiError(400, "x must lie inside the " + size + " image", "x");
   if (!(y >= 0 && y <= p.height)) throw ApiError(400, "y must lie inside the " + size + " image", "y");
-  auto desc = m_scenes.load(job.spec.scene);
+  auto base = m_scenes.load(job.spec.scene);
   p.env_map.clear();
-  auto scene = pt::make_render_scene(*desc, p);
+  auto scene = pt::make_view(*base, p);
   return pt::autofocus_distance(*scene, float(x / p.width), float(1 - y / p.height));
 }
 
@@ -381,50 +390,106 @@ void JobManager::worker_loop() {
   }
 }
 
+namespace {
+
+// Carries a backend's reports into the job's state (under its mutex) and wakes its watchers.
+class JobStateSink : public JobSink {
+ public:
+  JobStateSink(Job& job, std::function<void(Job&)> persist) : m_job(job), m_persist(std::move(persist)) {}
+
+  void started(int width, int height, const std::vector<std::string>& features) override {
+    Job& j = m_job;
+    {
+      std::lock_guard<std::mutex> lock(j.mutex);
+      if (j.cancel) throw ApiError(409, "cancelled");
+      j.state = JobState::running;
+      j.started_at = now_unix();
+      j.width = width;
+      j.height = height;
+      j.tile_size = j.spec.params.tile_size;
+      j.tiles_x = (width + j.tile_size - 1) / j.tile_size;
+      j.tiles_y = (height + j.tile_size - 1) / j.tile_size;
+      size_t n = size_t(width) * height;
+      j.linear.assign(n * 3, 0.0f);
+      j.display.assign(n * 3, 0);
+      j.tile_version.assign(size_t(j.tiles_x) * j.tiles_y, 0);
+      j.tile_png.assign(j.tile_version.size(), std::string());
+      j.tile_png_version.assign(j.tile_version.size(), 0);
+      j.samples = 0;
+      j.history.clear();
+      j.has_image = false;
+      j.features = features;
+      ++j.version;
+      m_persist(j);
+    }
+    m_start = std::chrono::steady_clock::now();
+    m_last_persist = m_start;
+    j.changed.notify_all();
+  }
+
+  void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean) override {
+    Job& j = m_job;
+    {
+      std::lock_guard<std::mutex> lock(j.mutex);
+      size_t k = 0;
+      for (int y = t.y0; y < t.y1; ++y)
+        for (int x = t.x0; x < t.x1; ++x, ++k) {
+          size_t i = (size_t(y) * j.width + x) * 3;
+          for (int c = 0; c < 3; ++c) {
+            j.linear[i + c] = mean[k][c];
+            j.display[i + c] = pt::tonemap_course(mean[k][c]);
+          }
+        }
+      j.tile_version[size_t(t.y0 / j.tile_size) * j.tiles_x + t.x0 / j.tile_size] = ++j.version;
+      j.has_image = true;
+      j.elapsed = seconds();
+    }
+    j.changed.notify_all();
+  }
+
+  void pass(const RenderReport& r) override {
+    Job& j = m_job;
+    {
+      std::lock_guard<std::mutex> lock(j.mutex);
+      j.samples = r.samples;
+      j.rays = r.rays;
+      j.nonfinite = r.nonfinite;
+      j.elapsed = seconds();
+      j.progress = r.progress;
+      if (std::isfinite(r.error)) {
+        j.error_estimate = r.error;
+        j.history.push_back({j.elapsed, double(r.samples) / (double(j.width) * j.height), r.error});
+      }
+      // ETA from the sample budget, or (when sooner) from error ~ 1/spp towards the target.
+      double eta = j.progress > 0 ? j.elapsed * (1 - j.progress) / j.progress : -1;
+      if (j.spec.target_error > 0 && std::isfinite(r.error) && r.error > 0)
+        eta = std::min(eta < 0 ? 1e30 : eta, j.elapsed * std::max(0.0, r.error / j.spec.target_error - 1));
+      if (j.spec.time_limit > 0) eta = std::min(eta < 0 ? 1e30 : eta, std::max(0.0, j.spec.time_limit - j.elapsed));
+      j.eta = eta;
+      ++j.version;
+      if (std::chrono::steady_clock::now() - m_last_persist > std::chrono::seconds(1)) {
+        m_persist(j);
+        m_last_persist = std::chrono::steady_clock::now();
+      }
+    }
+    j.changed.notify_all();
+  }
+
+ private:
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count(); }
+  Job& m_job;
+  std::function<void(Job&)> m_persist;
+  std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last_persist = m_start;
+};
+
+}  // namespace
+
 void JobManager::run_job(const std::shared_ptr<Job>& job) {
-  using clock = std::chrono::steady_clock;
   auto notify = [&] { job->changed.notify_all(); };
   try {
-    auto desc = m_scenes.load(job->spec.scene);
-    pt::RenderParams p = job->spec.params;
-    p.threads = std::max(1, m_config.threads);
-    auto scene = pt::make_render_scene(*desc, p);
-    pt::RenderSession session(*scene, p);
-    {
-      std::lock_guard<std::mutex> lock(job->mutex);
-      if (job->cancel) throw ApiError(409, "cancelled");
-      job->state = JobState::running;
-      job->started_at = now_unix();
-      job->width = session.width();
-      job->height = session.height();
-      job->tile_size = p.tile_size;
-      job->tiles_x = (job->width + p.tile_size - 1) / p.tile_size;
-      job->tiles_y = (job->height + p.tile_size - 1) / p.tile_size;
-      size_t n = size_t(job->width) * job->height;
-      job->linear.assign(n * 3, 0.0f);
-      job->display.assign(n * 3, 0);
-      job->tile_version.assign(size_t(job->tiles_x) * job->tiles_y, 0);
-      job->tile_png.assign(job->tile_version.size(), std::string());
-      job->tile_png_version.assign(job->tile_version.size(), 0);
-      job->samples = 0;
-      job->history.clear();
-      job->has_image = false;
-      const pt::SceneFeatures& f = scene->features;
-      job->features = f.materials;
-      for (const std::string& l : f.lights) job->features.push_back(l + " light");
-      if (f.spheres) job->features.push_back("spheres");
-      if (f.environment) job->features.push_back("environment map");
-      if (f.thin_lens) job->features.push_back("thin lens");
-      if (f.adaptive) job->features.push_back("adaptive sampling");
-      ++job->version;
-      persist(*job);
-    }
-    notify();
-
-    // One flag stops the session: user cancel or shutdown (polled every 20 ms). The time limit and
-    // the error target are the shared driver's (pt::run_progressive).
+    // One flag stops the render: user cancel or shutdown (polled every 20 ms). The time limit and
+    // the error target are the backend's.
     std::atomic<bool> stop{false}, done{false};
-    auto start = clock::now();
     std::thread poller([&] {
       while (!done) {
         if (job->cancel || m_stopping) {
@@ -443,61 +508,8 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
       }
     } joiner{done, poller};
 
-    auto on_tile = [&](const pt::Tile& t) {
-      thread_local std::vector<pt::Vec3> buf;
-      session.read_tile(t, buf);
-      {
-        std::lock_guard<std::mutex> lock(job->mutex);
-        size_t k = 0;
-        for (int y = t.y0; y < t.y1; ++y)
-          for (int x = t.x0; x < t.x1; ++x, ++k) {
-            size_t i = (size_t(y) * job->width + x) * 3;
-            for (int c = 0; c < 3; ++c) {
-              job->linear[i + c] = buf[k][c];
-              job->display[i + c] = pt::tonemap_course(buf[k][c]);
-            }
-          }
-        job->tile_version[size_t(t.y0 / job->tile_size) * job->tiles_x + t.x0 / job->tile_size] = ++job->version;
-        job->has_image = true;
-        // Progress and ETA move with every tile, not only at the end of a (doubling) pass.
-        job->progress = session.progress();
-        job->elapsed = std::chrono::duration<double>(clock::now() - start).count();
-        if (job->progress > 0 && job->spec.target_error <= 0 && job->spec.time_limit <= 0)
-          job->eta = job->elapsed * (1 - job->progress) / job->progress;
-      }
-      notify();
-    };
-
-    auto last_persist = clock::now();
-    auto on_pass = [&](const pt::PassReport& r) {
-      pt::SessionStats st = session.stats();
-      {
-        std::lock_guard<std::mutex> lock(job->mutex);
-        job->samples = st.samples;
-        job->rays = st.rays;
-        job->nonfinite = st.nonfinite;
-        job->elapsed = std::chrono::duration<double>(clock::now() - start).count();
-        job->progress = session.progress();
-        if (std::isfinite(r.error)) {
-          job->error_estimate = r.error;
-          job->history.push_back({job->elapsed, double(st.samples) / (double(job->width) * job->height), r.error});
-        }
-        // ETA from the sample budget, or (when sooner) from error ~ 1/spp towards the target.
-        double eta = job->progress > 0 ? job->elapsed * (1 - job->progress) / job->progress : -1;
-        if (job->spec.target_error > 0 && std::isfinite(r.error) && r.error > 0)
-          eta = std::min(eta < 0 ? 1e30 : eta, job->elapsed * std::max(0.0, r.error / job->spec.target_error - 1));
-        if (job->spec.time_limit > 0) eta = std::min(eta < 0 ? 1e30 : eta, std::max(0.0, job->spec.time_limit - job->elapsed));
-        job->eta = eta;
-        ++job->version;
-        if (clock::now() - last_persist > std::chrono::seconds(1)) {
-          persist(*job);
-          last_persist = clock::now();
-        }
-      }
-      notify();
-    };
-    pt::StopReason why = pt::run_progressive(session, {job->spec.time_limit, job->spec.target_error}, &stop, on_tile, on_pass);
-    bool completed = why != pt::StopReason::cancelled && why != pt::StopReason::time_limit;
+    JobStateSink sink(*job, [this](Job& j) { persist(j); });
+    RenderResult result = m_backend->render(*job, sink, stop);
 
     if (m_stopping && !job->cancel) {  // shutdown: run it again after a restart
       std::lock_guard<std::mutex> lock(job->mutex);
@@ -517,20 +529,18 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
       notify();
       return;
     }
-    // The time limit cut a pass short: its unfinished tiles never reached on_tile, so publish every
-    // tile once more and the event stream ends on the same picture as image.png.
-    if (!completed)
-      for (const pt::Tile& t : session.tiles()) on_tile(t);
     // Finished (sample budget, error target or time limit): images first, then the state.
-    pt::ImageRGB img = session.image();
+    const pt::ImageRGB& img = result.image;
+    const RenderReport& r = result.report;
     pt::Metadata meta{{"pathtracer:scene", job->spec.scene},
                       {"pathtracer:job", job->id},
                       {"pathtracer:spec", job_spec_to_json(job->spec).dump()},
-                      {"pathtracer:achieved_spp", std::to_string(double(session.stats().samples) / (double(img.width) * img.height))},
-                      {"pathtracer:wall_seconds", std::to_string(session.stats().seconds)},
-                      {"pathtracer:error_estimate", std::to_string(session.error_estimate())},
-                      {"pathtracer:seed", std::to_string(p.seed)},
-                      {"pathtracer:nonfinite_samples", std::to_string(session.stats().nonfinite)}};
+                      {"pathtracer:achieved_spp", std::to_string(double(r.samples) / (double(img.width) * img.height))},
+                      {"pathtracer:wall_seconds", std::to_string(result.seconds)},
+                      {"pathtracer:error_estimate", std::to_string(r.error)},
+                      {"pathtracer:seed", std::to_string(job->spec.params.seed)},
+                      {"pathtracer:nonfinite_samples", std::to_string(r.nonfinite)},
+                      {"pathtracer:backend", m_backend->name()}};
     try {
       pt::write_image(img, job_dir(job->id) + "/image.exr", meta);
       pt::write_image(img, job_dir(job->id) + "/image.png");
@@ -543,6 +553,9 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
     job->state = JobState::done;
     job->progress = 1;
     job->eta = 0;
+    job->samples = r.samples;
+    job->rays = r.rays;
+    job->nonfinite = r.nonfinite;
     job->finished_at = now_unix();
     ++job->version;
     persist(*job);

@@ -17,6 +17,8 @@
 
 namespace srv {
 
+class RenderBackend;
+
 // Reads a whole file (job images, job.json); false when it cannot be opened.
 bool read_file(const std::string& path, std::string& out);
 
@@ -65,6 +67,8 @@ struct ManagerConfig {
   int concurrency = 1;      // jobs rendering at once
   size_t max_queue = 32;    // queued jobs; more is refused
   SpecLimits limits;
+  std::string queue = "embedded";  // or redis://host:port: render-workers do the rendering
+  int units_in_flight = 4;         // Redis: sample passes queued ahead of the merges, per job
 };
 
 class JobManager {
@@ -91,6 +95,8 @@ class JobManager {
   // infinity when the ray escapes. What the page's click-to-focus sets the focal distance to.
   double focus_distance(const Job& job, double x, double y);
   const ManagerConfig& config() const { return m_config; }
+  std::string backend_name() const;
+  int live_workers() const;  // -1 for the embedded backend
   SceneLibrary& scenes() { return m_scenes; }
   std::string job_dir(const std::string& id) const;
   bool stopping() const { return m_stopping.load(); }
@@ -104,6 +110,7 @@ class JobManager {
 
   ManagerConfig m_config;
   SceneLibrary m_scenes;
+  std::unique_ptr<RenderBackend> m_backend;
   mutable std::mutex m_mutex;
   std::condition_variable m_queue_cv;
   std::map<std::string, std::shared_ptr<Job>> m_jobs;

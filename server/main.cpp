@@ -26,6 +26,10 @@ const char* kUsage =
     "  --threads N       render threads per job (default: all cores)\n"
     "  --concurrency N   jobs rendering at once (default 1)\n"
     "  --max-queue N     queued jobs before new ones are refused with 429 (default 32)\n"
+    "  --queue URL       'embedded' (default: render here) or redis://HOST:PORT: hand sample passes\n"
+    "                    to render-worker processes through Redis Streams (docs/scale-out.md)\n"
+    "  --units-in-flight N  Redis: passes queued ahead of the merges per job (default 4; about\n"
+    "                    the number of workers)\n"
     "  --token T         require 'Authorization: Bearer T' on /api (all but /api/health); also read\n"
     "                    from the environment variable RENDER_SERVER_TOKEN. The page asks for it.\n"
     "  --max-connections N  open connections before new ones are answered 503 (default 128)\n"
@@ -80,6 +84,8 @@ int main(int argc, char** argv) {
     else if (a == "--threads") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.threads = int(n); }
     else if (a == "--concurrency") { const char* v = value(); if (!parse_int(v, 1, 64, &n)) bad(v); cfg.concurrency = int(n); }
     else if (a == "--max-queue") { const char* v = value(); if (!parse_int(v, 0, 100000, &n)) bad(v); cfg.max_queue = size_t(n); }
+    else if (a == "--queue") cfg.queue = value();
+    else if (a == "--units-in-flight") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.units_in_flight = int(n); }
     else if (a == "--token") api.token = value();
     else if (a == "--max-connections") { const char* v = value(); if (!parse_int(v, 1, 10000, &n)) bad(v); api.limits.max_connections = int(n); }
     else if (a == "--read-timeout") { const char* v = value(); if (!parse_seconds(v, &api.limits.request_timeout)) bad(v); }
@@ -124,7 +130,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   svr.widen_backlog();
-  std::printf("render-server: listening on http://%s:%d/\n", host.c_str(), bound);
+  std::printf("render-server: listening on http://%s:%d/ (rendering: %s)\n", host.c_str(), bound,
+              jobs.backend_name().c_str());
   std::fflush(stdout);
 
   std::thread signal_thread([&] {

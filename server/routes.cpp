@@ -323,7 +323,10 @@ void install_routes(httplib::Server& svr, JobManager& jobs, const ApiOptions& op
       queued += j->state == JobState::queued;
       running += j->state == JobState::running;
     }
-    send_json(res, 200, {{"status", "ok"}, {"queued", queued}, {"running", running}});
+    json health{{"status", "ok"}, {"queued", queued}, {"running", running}, {"rendering", jobs.backend_name()}};
+    int workers = jobs.live_workers();
+    if (workers >= 0) health["workers"] = workers;
+    send_json(res, 200, health);
   });
 
   svr.Get("/api/openapi.json", [openapi](const httplib::Request&, httplib::Response& res) {

@@ -1,14 +1,17 @@
-// Scene name resolution, the shared scene cache, and the scene list for GET /api/scenes.
+// Scene name resolution, the cache of shared render-scene bases, and the scene list for
+// GET /api/scenes.
 #include "scene_library.h"
 
 #include <dirent.h>
 #include <sys/stat.h>
 
+#include <chrono>
 #include <climits>
-#include <fstream>
-#include <sstream>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 #include "camera.h"
 #include "collada.h"
@@ -61,7 +64,7 @@ std::string SceneLibrary::resolve(const std::string& name) const {
   return "";
 }
 
-std::shared_ptr<const pt::SceneDesc> SceneLibrary::load(const std::string& name) {
+std::string SceneLibrary::read_scene(const std::string& name, uint64_t* hash) const {
   std::string path = resolve(name);
   if (path.empty()) throw ApiError(404, "unknown scene '" + name + "'", "scene");
   // Checked before reading: the whole file is held in memory while it parses.
@@ -75,30 +78,66 @@ std::shared_ptr<const pt::SceneDesc> SceneLibrary::load(const std::string& name)
   if (!in) throw ApiError(404, "scene '" + name + "' cannot be read", "scene");
   std::string bytes = text.str();
   // FNV-1a over the content: an edited file is parsed again; identical files share one parse.
-  uint64_t hash = 1469598103934665603ull;
-  for (unsigned char ch : bytes) hash = (hash ^ ch) * 1099511628211ull;
-  {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    auto it = m_cache.find(hash);
-    if (it != m_cache.end()) {
-      m_last_hash[name] = hash;
-      return it->second.desc;
-    }
-  }
-  // Parse outside the lock: a big scene must not block status requests. Messages name the
-  // scene, not the server's paths.
-  auto desc = std::make_shared<const pt::SceneDesc>(pt::parse_collada(bytes, name + ".dae"));
-  Entry e{desc, summarize(*desc)};
-  std::lock_guard<std::mutex> lock(m_mutex);
-  m_cache[hash] = e;
-  m_last_hash[name] = hash;
-  // Forget contents no scene name points to any more (running jobs keep their own reference).
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : bytes) h = (h ^ ch) * 1099511628211ull;
+  *hash = h;
+  return bytes;
+}
+
+void SceneLibrary::forget_unused() {
+  // Contents no scene name points to any more (running jobs keep their own reference).
   for (auto it = m_cache.begin(); it != m_cache.end();) {
     bool used = false;
     for (const auto& kv : m_last_hash) used |= kv.second == it->first;
     it = used ? std::next(it) : m_cache.erase(it);
   }
-  return desc;
+}
+
+std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name) {
+  uint64_t hash = 0;
+  std::string bytes = read_scene(name, &hash);
+  std::promise<Base> promise;
+  std::shared_future<Base> result;
+  uint64_t build_id = 0;
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_last_hash[name] = hash;
+    Entry& e = m_cache[hash];
+    if (!e.base.valid()) {  // the first to ask builds; the others wait on its future
+      e.base = promise.get_future().share();
+      e.build_id = build_id = ++m_next_build;
+    }
+    result = e.base;
+    forget_unused();
+  }
+  if (build_id == 0) return result.get();  // rethrows the builder's error
+  // Parse and build outside the lock: a big scene must not block status requests. Messages name
+  // the scene, not the server's paths.
+  try {
+    auto t0 = std::chrono::steady_clock::now();
+    pt::SceneDesc desc = pt::parse_collada(bytes, name + ".dae");
+    std::string().swap(bytes);
+    json summary = summarize(desc);
+    auto base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(desc));
+    desc = pt::SceneDesc();  // from here on only the base holds the scene
+    double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::fprintf(stderr, "render-server: scene '%s' built in %.3f s (%zu triangles, %zu spheres, %.2f MiB), shared by its jobs\n",
+                 name.c_str(), s, base->triangle_count, base->sphere_count, base->memory_bytes() / 1048576.0);
+    {
+      std::lock_guard<std::mutex> lock(m_mutex);
+      auto it = m_cache.find(hash);
+      if (it != m_cache.end()) it->second.summary = summary;
+    }
+    promise.set_value(base);
+  } catch (...) {
+    {  // not cached: the next request tries again
+      std::lock_guard<std::mutex> lock(m_mutex);
+      auto it = m_cache.find(hash);
+      if (it != m_cache.end() && it->second.build_id == build_id) it->second.base = {};
+    }
+    promise.set_exception(std::current_exception());
+  }
+  return result.get();
 }
 
 json SceneLibrary::list() {
@@ -119,15 +158,32 @@ json SceneLibrary::list() {
   for (const std::string& name : names) {
     json item{{"name", name}};
     try {
-      load(name);
-      std::lock_guard<std::mutex> lock(m_mutex);
-      item["summary"] = m_cache[m_last_hash[name]].summary;
+      item["summary"] = summary(name);
     } catch (const std::exception& e) {
       item["error"] = e.what();
     }
     out.push_back(item);
   }
   return out;
+}
+
+json SceneLibrary::summary(const std::string& name) {
+  uint64_t hash = 0;
+  std::string bytes = read_scene(name, &hash);
+  json summary;
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_last_hash[name] = hash;
+    auto it = m_cache.find(hash);
+    if (it != m_cache.end()) summary = it->second.summary;
+    forget_unused();
+  }
+  if (summary.is_null()) {  // parsed for its summary only: the base is built by the first job
+    summary = summarize(pt::parse_collada(bytes, name + ".dae"));
+    std::lock_guard<std::mutex> lock(m_mutex);
+    if (m_last_hash[name] == hash) m_cache[hash].summary = summary;
+  }
+  return summary;
 }
 
 }  // namespace srv

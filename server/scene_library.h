@@ -1,7 +1,10 @@
 // Scene files the server may render: names resolved only inside the configured directories
-// (no paths, no symlinks out), parsed once per distinct file content and shared between jobs.
+// (no paths, no symlinks out); per distinct file content, one summary and one shared render-scene
+// base (BVH, lights, materials) that every job on it views. The file's vertex arrays are not kept.
 #pragma once
 
+#include <cstdint>
+#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -9,7 +12,7 @@
 #include <vector>
 
 #include "job_spec.h"
-#include "scene.h"
+#include "render.h"
 
 namespace srv {
 
@@ -18,20 +21,32 @@ class SceneLibrary {
   explicit SceneLibrary(std::vector<std::string> dirs);
   // The file for a scene name, or "" when no configured directory holds it.
   std::string resolve(const std::string& name) const;
-  // Loads (or reuses) a scene; throws ApiError(404) for an unknown name, pt::SceneError for a bad file.
-  std::shared_ptr<const pt::SceneDesc> load(const std::string& name);
-  // Every scene with a summary (counts, materials, lights, the course camera's focus distance).
+  // The scene's shared render base (a job makes its view with pt::make_view), built at most once
+  // per file content however many jobs ask at the same time. Throws ApiError(404) for an unknown
+  // name, pt::SceneError for a bad file.
+  std::shared_ptr<const pt::SceneBase> load(const std::string& name);
+  // A scene's summary (counts, materials, lights, the course camera's focus distance); parses a
+  // file it has not seen but builds nothing, so it also validates cheaply. Throws as load() does.
+  json summary(const std::string& name);
+  // Every scene with its summary, or its load error.
   json list();
 
  private:
+  using Base = std::shared_ptr<const pt::SceneBase>;
   struct Entry {
-    std::shared_ptr<const pt::SceneDesc> desc;
-    json summary;
+    json summary;                   // null until the content was parsed once
+    std::shared_future<Base> base;  // valid once a build started; ready when it ended
+    uint64_t build_id = 0;          // which load() is building it
   };
+  // The file's bytes and their FNV-1a hash; throws as load() does.
+  std::string read_scene(const std::string& name, uint64_t* hash) const;
+  void forget_unused();  // with m_mutex held
+
   std::vector<std::string> m_dirs;  // canonical
   std::mutex m_mutex;
   std::map<uint64_t, Entry> m_cache;            // by content hash
   std::map<std::string, uint64_t> m_last_hash;  // scene name -> hash of its last loaded content
+  uint64_t m_next_build = 0;
 };
 
 }  // namespace srv

@@ -1,9 +1,11 @@
 // Leave out what a scene does not need: the derived feature set of every scene is what the file
-// contains, and the specialised path loop renders exactly what the generic one does.
+// contains, the specialised path loop renders exactly what the generic one does, and views of one
+// shared scene base render exactly what make_render_scene's scenes do.
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <set>
+#include <thread>
 
 #include "collada.h"
 #include "render.h"
@@ -138,4 +140,97 @@ TEST(Features, SpecialisedAndGenericLoopsRenderTheSameImage) {
     EXPECT_EQ(std::memcmp(ia.pixels.data(), ib.pixels.data(), ia.pixels.size() * sizeof(Vec3)), 0);
     EXPECT_GT(a.stats().samples, 0u);
   }
+}
+
+// The server's sharing: one SceneBase (BVH, lights, materials) per scene file, a cheap view per
+// job. Each view renders bit-identically to make_render_scene with the same options and seed.
+TEST(Features, ViewsOfASharedBaseRenderWhatMakeRenderSceneRenders) {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  ImageRGB env;
+  env.width = 16;
+  env.height = 8;
+  env.pixels.assign(128, Vec3(0.2f, 0.3f, 0.5f));
+  std::string env_path = test::temp_dir() + "/features_shared_sky.exr";
+  write_image(env, env_path);
+  auto base = std::make_shared<const SceneBase>(make_scene_base(desc));
+  ASSERT_TRUE(base->accel);
+  EXPECT_GE(base->memory_bytes(), base->accel->memory_bytes());
+  EXPECT_GT(base->accel->memory_bytes(), 0u);
+  EXPECT_EQ(base->triangle_count, desc.triangle_count());
+
+  std::vector<RenderParams> views(4);
+  for (RenderParams& p : views) {
+    p.width = 40;
+    p.height = 30;
+    p.spp = 8;
+    p.max_depth = 4;
+    p.light_samples = 2;
+    p.seed = 5;
+    p.threads = 1;
+  }
+  views[1].width = 24;  // another size and a thin lens
+  views[1].lens_radius = 0.05f;
+  views[1].focal_distance = 4;
+  views[2].env_map = env_path;  // an environment map and the file's camera
+  views[2].file_camera = desc.camera.present;
+  views[3].generic = true;
+  views[3].spp = 64;  // adaptive
+  std::vector<std::unique_ptr<RenderScene>> made;
+  for (const RenderParams& p : views) made.push_back(make_view(*base, p));
+  base.reset();  // the views keep what they share alive
+  // Render all views at once: the shared BVH is read from several threads.
+  std::vector<ImageRGB> images(views.size());
+  std::vector<std::thread> threads;
+  for (size_t i = 0; i < views.size(); ++i)
+    threads.emplace_back([&, i] {
+      RenderSession s(*made[i], views[i]);
+      s.render_all();
+      images[i] = s.image();
+    });
+  for (std::thread& t : threads) t.join();
+
+  for (size_t i = 0; i < views.size(); ++i) {
+    SCOPED_TRACE("view " + std::to_string(i));
+    EXPECT_EQ(made[i]->accel, made[0]->accel) << "each view must share the base's BVH, not build its own";
+    auto direct = make_render_scene(desc, views[i]);
+    const SceneFeatures &a = made[i]->features, &b = direct->features;
+    EXPECT_EQ(a.materials, b.materials);
+    EXPECT_EQ(a.lights, b.lights);
+    EXPECT_EQ(a.bits, b.bits);
+    EXPECT_EQ(a.environment, b.environment);
+    EXPECT_EQ(a.thin_lens, b.thin_lens);
+    EXPECT_EQ(a.adaptive, b.adaptive);
+    EXPECT_EQ(made[i]->lights.size(), direct->lights.size());
+    EXPECT_EQ(made[i]->infinite_lights, direct->infinite_lights);
+    RenderSession s(*direct, views[i]);
+    s.render_all();
+    ImageRGB want = s.image();
+    ASSERT_EQ(images[i].pixels.size(), want.pixels.size());
+    EXPECT_EQ(std::memcmp(images[i].pixels.data(), want.pixels.data(), want.pixels.size() * sizeof(Vec3)), 0);
+  }
+  EXPECT_TRUE(made[1]->features.thin_lens);
+  EXPECT_TRUE(made[2]->features.environment);
+  EXPECT_EQ(made[3]->features.bits, uint32_t(kFeatAll));
+  EXPECT_NE(made[0]->features.bits, uint32_t(kFeatAll));  // the generic view did not leak into the base
+}
+
+// The base is what the file contains, whatever options a view adds later.
+TEST(Features, SceneBaseHoldsNoOptions) {
+  SceneDesc desc = load_collada(test::own_scene("dof.dae"));
+  SceneBase base = make_scene_base(desc);
+  EXPECT_FALSE(base.features.environment);
+  EXPECT_FALSE(base.features.thin_lens);
+  EXPECT_FALSE(base.features.adaptive);
+  EXPECT_EQ(base.features.bits, 0u);
+  EXPECT_EQ(base.camera.present, desc.camera.present);
+  Bounds3 b = desc.geometry_bounds();
+  EXPECT_EQ(base.bounds.lo, b.lo);
+  EXPECT_EQ(base.bounds.hi, b.hi);
+  // The camera made from the base equals the one made from the file.
+  RenderParams p;
+  p.file_camera = false;
+  Camera from_base = make_view(base, p)->camera, from_file = make_camera(desc, camera_params(p));
+  EXPECT_EQ(from_base.position, from_file.position);
+  EXPECT_EQ(from_base.back, from_file.back);
+  EXPECT_EQ(from_base.screen_distance, from_file.screen_distance);
 }

@@ -226,7 +226,7 @@ class Server:
                 chunk = os.read(self.proc.stdout.fileno(), 1)
                 assert chunk, f"server exited: {self.log_text()}"
                 line += chunk
-        m = re.fullmatch(rb"render-server: listening on http://127\.0\.0\.1:(\d+)/\n", line)
+        m = re.fullmatch(rb"render-server: listening on http://127\.0\.0\.1:(\d+)/ \(rendering: [^)]+\)\n", line)
         assert m, f"unexpected first line {line!r}"
         self.port = int(m[1])
         self.url = f"http://127.0.0.1:{self.port}"

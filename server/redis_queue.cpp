@@ -1,0 +1,53 @@
+#include "redis_queue.h"
+
+#include <cstdlib>
+
+namespace srv::rq {
+
+void ensure_group(RedisClient& redis) {
+  RedisReply r = redis.command({"XGROUP", "CREATE", kWorkStream, kGroup, "$", "MKSTREAM"}, true);
+  if (r.type == RedisReply::error && r.str.rfind("BUSYGROUP", 0) != 0)
+    throw RedisError("Redis at " + redis.address().url() + ": cannot create the consumer group: " + r.str);
+}
+
+int count_workers(RedisClient& redis) {
+  int n = 0;
+  std::string cursor = "0";
+  do {
+    RedisReply r = redis.command({"SCAN", cursor, "MATCH", "pt:worker:*", "COUNT", "1000"});
+    if (r.elements.size() != 2) break;
+    cursor = r.elements[0].str;
+    n += int(r.elements[1].elements.size());
+  } while (cursor != "0");
+  return n;
+}
+
+namespace {
+
+bool parse_u32(const std::string* s, uint32_t& out) {
+  if (!s || s->empty() || s->size() > 10) return false;
+  char* end = nullptr;
+  unsigned long long v = std::strtoull(s->c_str(), &end, 10);
+  if (*end || v > 0xffffffffull) return false;
+  out = uint32_t(v);
+  return true;
+}
+
+}  // namespace
+
+bool parse_work_item(const RedisReply& entry, WorkItem& out) {
+  // An entry is [id, [field, value, ...]]; an entry deleted while pending has a nil body.
+  if (entry.type != RedisReply::array || entry.elements.size() != 2) return false;
+  out = WorkItem();
+  out.entry_id = entry.elements[0].str;
+  const RedisReply& body = entry.elements[1];
+  const std::string *job = body.field("job"), *run = body.field("run"), *mask = body.field("mask");
+  if (!job || !run || job->empty() || run->empty()) return false;
+  out.job = *job;
+  out.run = *run;
+  if (mask) out.mask = *mask;
+  return parse_u32(body.field("unit"), out.unit) && parse_u32(body.field("first"), out.first) &&
+         parse_u32(body.field("count"), out.count) && out.count > 0;
+}
+
+}  // namespace srv::rq

@@ -1,0 +1,61 @@
+// The job service's queue interface: where a job's samples are computed. The job manager owns a
+// job's state and files; a backend renders and reports through a JobSink. Two backends exist: the
+// embedded one renders in this process (the default), the Redis one hands sample passes to
+// render-worker processes on any number of machines (see docs/scale-out.md).
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render.h"
+
+namespace srv {
+
+class SceneLibrary;
+struct Job;
+
+struct RenderReport {
+  double progress = 0;  // fraction of the sample budget done
+  uint64_t samples = 0, rays = 0, nonfinite = 0;
+  double error = INFINITY;  // the error estimate (relMSE) after the last merged pass
+};
+
+class JobSink {
+ public:
+  virtual ~JobSink() = default;
+  // Once, before any tile: the film size and the scene's feature set. Throws if the job was
+  // cancelled meanwhile.
+  virtual void started(int width, int height, const std::vector<std::string>& features) = 0;
+  // A tile's pixels (mean radiance, row by row) changed. May be called from several threads.
+  virtual void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean) = 0;
+  // After each pass (a doubling pass, or a merged worker pass).
+  virtual void pass(const RenderReport& r) = 0;
+};
+
+struct RenderResult {
+  pt::StopReason why = pt::StopReason::finished;
+  pt::ImageRGB image;
+  RenderReport report;
+  double seconds = 0;  // rendering time
+};
+
+class RenderBackend {
+ public:
+  virtual ~RenderBackend() = default;
+  // Renders the job until its budget, error target or time limit, or until `stop` is set (then
+  // the result says cancelled). Throws for a job that cannot render (bad scene, lost queue).
+  virtual RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop) = 0;
+  // "embedded" or the queue's URL, for logs and /api/health.
+  virtual std::string name() const = 0;
+  // Render workers seen in the last few seconds; -1 where the backend has none (embedded).
+  virtual int live_workers() { return -1; }
+};
+
+// The embedded backend: renders in this process with `threads` threads.
+std::unique_ptr<RenderBackend> make_embedded_backend(SceneLibrary& scenes, int threads);
+// The Redis backend: `url` is redis://host:port. Throws when Redis cannot be reached.
+std::unique_ptr<RenderBackend> make_redis_backend(SceneLibrary& scenes, const std::string& url, int units_in_flight);
+
+}  // namespace srv

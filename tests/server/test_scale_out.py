@@ -1,0 +1,182 @@
+"""Scale-out (docs/scale-out.md): a real redis-server on a loopback port, render-server with --queue
+and three render-worker processes. A job renders through the workers; one worker is killed with
+SIGKILL while it holds a pass, another claims that pass, and the job still finishes with the image a
+single process renders (passes merge as sums of the same samples, so the two agree to float
+rounding). Cancel, the event stream and a failed scene behave as with the embedded queue."""
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from support import SOURCE_DIR, read_exr
+
+RENDER_WORKER = Path(os.environ.get("PT_RENDER_WORKER", SOURCE_DIR / "build/render-worker"))
+JOB = {"scene": "cornell", "width": 160, "height": 120, "spp": 256, "max_depth": 4, "adaptive": False, "seed": 7}
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Redis:
+    def __init__(self, root):
+        assert shutil.which("redis-server"), "redis-server is missing: run scripts/install-deps.sh"
+        self.port = free_port()
+        self.proc = subprocess.Popen(["redis-server", "--port", str(self.port), "--bind", "127.0.0.1", "--save", "",
+                                      "--appendonly", "no", "--dir", str(root)],
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.monotonic() + 10
+        while self.cli("PING") != "PONG":
+            assert time.monotonic() < deadline and self.proc.poll() is None, "redis-server did not start"
+            time.sleep(0.05)
+        self.url = f"redis://127.0.0.1:{self.port}"
+
+    def cli(self, *args):
+        r = subprocess.run(["redis-cli", "-p", str(self.port), *args], capture_output=True, text=True, timeout=10)
+        return r.stdout.strip()
+
+    def pending_by_worker(self):
+        """{consumer: passes it holds unacknowledged} in the group."""
+        out = self.cli("XPENDING", "pt:work", "workers").splitlines()
+        # Summary: count, smallest id, largest id, then consumer/count pairs.
+        pairs = out[3:] if len(out) > 3 else []
+        return {pairs[i]: int(pairs[i + 1]) for i in range(0, len(pairs) - 1, 2)}
+
+    def stop(self):
+        self.proc.kill()
+        self.proc.wait(10)
+
+
+class Worker:
+    def __init__(self, root, redis_url, name):
+        self.name = name
+        self.log_path = Path(root) / f"{name}.log"
+        self.log = open(self.log_path, "wb")
+        self.proc = subprocess.Popen([str(RENDER_WORKER), "--queue", redis_url, "-t", "1", "--name", name,
+                                      "--claim-timeout", "1"], stdout=self.log, stderr=self.log)
+
+    def text(self):
+        return self.log_path.read_text(errors="replace")
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.kill()
+        self.proc.wait(10)
+        self.log.close()
+
+
+@pytest.fixture
+def cluster(tmp_path, servers):
+    redis = Redis(tmp_path)
+    workers = []
+
+    def start(n_workers=3):
+        srv = servers("scaled", threads=1, args=["--queue", redis.url, "--units-in-flight", "4"])
+        workers.extend(Worker(tmp_path, redis.url, f"w{i + 1}") for i in range(n_workers))
+        return srv, workers, redis
+
+    yield start
+    for w in workers:
+        w.stop()
+        print(f"---- {w.name} ----\n{w.text()[-3000:]}")
+    redis.stop()
+
+
+def wait_for(predicate, what, timeout=10):
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        assert time.monotonic() < deadline, f"timed out waiting: {what}"
+        time.sleep(0.05)
+
+
+def image(api, job_id):
+    w, h, ch, attrs = read_exr(api.get(f"/api/jobs/{job_id}/image.exr").content)
+    return w, h, ch, attrs
+
+
+def test_killed_worker_loses_nothing_and_image_matches_single_process(cluster, servers):
+    srv, workers, redis = cluster(3)
+    api = srv.api
+    assert api.get("/api/health").json()["rendering"] == redis.url
+    wait_for(lambda: api.get("/api/health").json()["workers"] == 3, "three workers announced")
+    job_id = api.submit(JOB)["id"]
+
+    # Kill -9 a worker while it holds a pass (unacknowledged in the consumer group).
+    victim, deadline = None, time.monotonic() + 60
+    while victim is None:
+        assert time.monotonic() < deadline, "no worker ever held a pass"
+        holding = redis.pending_by_worker()
+        job = api.job(job_id)
+        assert job["state"] in ("queued", "running"), job
+        if job["samples"] > 0:
+            victim = next((w for w in workers if holding.get(w.name, 0) > 0), None)
+        time.sleep(0.02)
+    victim.proc.send_signal(signal.SIGKILL)
+    victim.proc.wait(10)
+    wait_for(lambda: api.get("/api/health").json()["workers"] == 2, "the killed worker no longer counted", 15)
+
+    done = api.wait(job_id, {"done", "failed", "cancelled"}, timeout=180)
+    assert done["state"] == "done", done
+    assert done["samples"] == JOB["width"] * JOB["height"] * JOB["spp"], "every sample rendered exactly once"
+    claimed = [w.name for w in workers if "left by another worker" in w.text()]
+    assert claimed, "no worker took over the killed worker's pass"
+    left = [k for k in redis.cli("KEYS", f"pt:*:{job_id}:*").splitlines() if k]
+    assert not left, f"the run's keys were not removed: {left}"
+
+    # The same job on an embedded server: the same samples, so the same image up to float rounding.
+    single = servers("single", threads=2)
+    ref_id = single.api.submit(JOB)["id"]
+    assert single.api.wait(ref_id, {"done", "failed"}, timeout=180)["state"] == "done"
+    w, h, dist, attrs = image(api, job_id)
+    _, _, ref, _ = image(single.api, ref_id)
+    assert attrs["pathtracer:backend"] == redis.url
+    worst = 0.0
+    for c in "RGB":
+        for a, b in zip(dist[c], ref[c]):
+            worst = max(worst, abs(a - b) / (abs(b) + 1e-3))
+    assert worst < 1e-3, f"distributed and single-process images differ by up to {worst:.2e} (relative)"
+    assert done["error_estimate"] is not None and done["error_estimate"] > 0
+
+
+def test_events_stream_merged_passes_and_adaptive_converges(cluster):
+    srv, workers, redis = cluster(2)
+    spec = dict(JOB, adaptive=True, spp=2048, width=96, height=72, seed=3)
+    job_id = srv.api.submit(spec)["id"]
+    stream = srv.events(job_id, timeout=120)
+    kinds = {}
+    for ev in stream:
+        kinds[ev.kind] = kinds.get(ev.kind, 0) + 1
+        if ev.kind == "end":
+            break
+    stream.close()
+    job = srv.api.job(job_id)
+    assert job["state"] == "done", job
+    assert kinds.get("tile", 0) >= 2 * 9, f"tiles should stream as passes merge: {kinds}"  # 3x3 tiles, 2+ passes
+    assert "adaptive sampling" in job["features"] and "glass" in job["features"]
+    # Adaptive sampling on merged statistics stops converged pixels early.
+    assert job["samples"] < spec["width"] * spec["height"] * spec["spp"], job["samples"]
+
+
+def test_cancel_stops_the_workers(cluster):
+    srv, workers, redis = cluster(2)
+    spec = dict(JOB, spp=65536, width=160, height=120)
+    job_id = srv.api.submit(spec)["id"]
+    srv.api.wait(job_id, {"running"}, timeout=60, samples=1)
+    t0 = time.monotonic()
+    srv.api.delete(f"/api/jobs/{job_id}")
+    job = srv.api.wait(job_id, {"cancelled"}, timeout=30)
+    assert job["state"] == "cancelled"
+    # Workers see the run's key gone and drop their passes: nothing stays pending for long.
+    deadline = time.monotonic() + 20
+    while redis.pending_by_worker():
+        assert time.monotonic() < deadline, f"passes still held after cancel: {redis.pending_by_worker()}"
+        time.sleep(0.1)
+    assert time.monotonic() - t0 < 20
+    assert all(w.proc.poll() is None for w in workers), "a worker died"
