@@ -77,8 +77,13 @@ class RedisBackend : public RenderBackend {
 
     RedisClient redis(m_address);
     const std::string run = new_run_id(), job_key = rq::job_key(job.id, run), results = rq::results_key(job.id, run);
-    redis.command({"HSET", job_key, "spec", job_spec_to_json(spec).dump(), "scene", scene_text});
-    redis.command({"EXPIRE", job_key, std::to_string(rq::kKeyTtlSeconds)});
+    // The scene's bytes go up once per content: repeated jobs on a large scene send only its hash.
+    const std::string scene_hash = rq::content_hash(scene_text), ttl = std::to_string(rq::kKeyTtlSeconds);
+    redis.command({"SET", rq::scene_key(scene_hash), scene_text, "EX", ttl, "NX"});
+    redis.command({"EXPIRE", rq::scene_key(scene_hash), ttl});
+    std::string().swap(scene_text);
+    redis.command({"HSET", job_key, "spec", job_spec_to_json(spec).dump(), "scene", scene_hash});
+    redis.command({"EXPIRE", job_key, ttl});
     struct Cleanup {  // however the render ends, workers learn the run is over
       RedisClient& redis;
       std::string job_key, results;

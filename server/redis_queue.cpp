@@ -1,5 +1,6 @@
 #include "redis_queue.h"
 
+#include <cstdio>
 #include <cstdlib>
 
 namespace srv::rq {
@@ -48,6 +49,14 @@ bool parse_work_item(const RedisReply& entry, WorkItem& out) {
   if (mask) out.mask = *mask;
   return parse_u32(body.field("unit"), out.unit) && parse_u32(body.field("first"), out.first) &&
          parse_u32(body.field("count"), out.count) && out.count > 0;
+}
+
+std::string content_hash(const std::string& bytes) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : bytes) h = (h ^ ch) * 1099511628211ull;
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
+  return buf;
 }
 
 }  // namespace srv::rq

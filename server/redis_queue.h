@@ -1,8 +1,10 @@
 // The Redis layout shared by the server's Redis backend and render-worker (docs/scale-out.md):
 //   pt:work                 stream of sample passes, read by the consumer group "workers"
 //                           (job, run, unit, first, count, mask: the converged pixels, 1 bit each)
-//   pt:job:<job>:<run>      hash: spec (the job's JSON spec) and scene (the .dae file's bytes);
-//                           deleting it tells workers the run is over (cancelled or finished)
+//   pt:job:<job>:<run>      hash: spec (the job's JSON spec) and scene (the hash of the .dae
+//                           file's bytes); deleting it tells workers the run is over
+//   pt:scene:<hash>         the .dae file's bytes, shared by every run of the same content (a
+//                           worker that has built that scene fetches nothing more)
 //   pt:results:<job>:<run>  stream of finished passes (unit, worker, pass: a pt::FilmPass
 //                           encoding, features) or failures (unit, worker, error)
 //   pt:worker:<name>        a live worker's presence (its thread count), expiring kWorkerTtlSeconds
@@ -21,6 +23,9 @@ namespace srv::rq {
 inline const std::string kWorkStream = "pt:work";
 inline const std::string kGroup = "workers";
 inline std::string job_key(const std::string& job, const std::string& run) { return "pt:job:" + job + ":" + run; }
+inline std::string scene_key(const std::string& hash) { return "pt:scene:" + hash; }
+// FNV-1a of a scene file's bytes, as 16 hex digits.
+std::string content_hash(const std::string& bytes);
 inline std::string results_key(const std::string& job, const std::string& run) {
   return "pt:results:" + job + ":" + run;
 }

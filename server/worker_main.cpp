@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <list>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -45,13 +46,17 @@ struct Options {
   bool quiet = false;
 };
 
-// The scene and spec of the run most recently worked on: consecutive passes of a job reuse them.
+// A run being worked on: its spec and its view of the scene. A worker keeps the few most recent
+// (jobs rendering at once interleave their passes) and the scene bases they share, keyed by the
+// file's content hash, so that a switch between runs rebuilds and downloads nothing.
 struct PreparedRun {
   std::string key;
   JobSpec spec;
+  std::shared_ptr<const pt::SceneBase> base;
   std::unique_ptr<pt::RenderScene> scene;
   std::vector<std::string> features;
 };
+constexpr size_t kRunsKept = 4, kBasesKept = 2;
 
 class Worker {
  public:
@@ -123,7 +128,7 @@ class Worker {
         return;
       }
       std::string features;
-      for (const std::string& f : m_prepared.features) features += (features.empty() ? "" : ",") + f;
+      for (const std::string& f : m_runs.front()->features) features += (features.empty() ? "" : ",") + f;
       m_redis.command({"XADD", results, "*", "unit", std::to_string(item.unit), "worker", m_opt.name, "pass",
                        pass.encode(), "features", features});
       m_redis.command({"EXPIRE", results, std::to_string(rq::kKeyTtlSeconds)});
@@ -140,22 +145,45 @@ class Worker {
     }
   }
 
-  // Loads the run's spec and scene unless they are the ones already prepared; false if the run's
-  // key is gone.
+  // Makes the run's spec and view current, from the cache or from Redis; false if the run's key
+  // is gone (the run is over).
   bool prepare(const rq::WorkItem& item) {
     std::string key = rq::job_key(item.job, item.run);
-    if (m_prepared.key == key) return m_redis.command({"EXISTS", key}).integer_value == 1;
-    RedisReply r = m_redis.command({"HGETALL", key});
-    const std::string *spec = r.field("spec"), *scene = r.field("scene");
-    if (!spec || !scene) return false;
-    m_prepared = PreparedRun();
-    m_prepared.spec = parse_job_spec(json::parse(*spec));
-    m_prepared.spec.params.threads = m_opt.threads;
-    pt::SceneDesc desc = pt::parse_collada(*scene, m_prepared.spec.scene + ".dae");
-    m_prepared.scene = pt::make_render_scene(desc, m_prepared.spec.params);
-    m_prepared.features = feature_names(m_prepared.scene->features);
-    m_prepared.key = key;
+    for (auto it = m_runs.begin(); it != m_runs.end(); ++it)
+      if ((*it)->key == key) {
+        m_runs.splice(m_runs.begin(), m_runs, it);  // most recent first
+        return m_redis.command({"EXISTS", key}).integer_value == 1;
+      }
+    RedisReply r = m_redis.command({"HMGET", key, "spec", "scene"});
+    if (r.elements.size() != 2 || r.elements[0].is_nil() || r.elements[1].is_nil()) return false;
+    auto run = std::make_unique<PreparedRun>();
+    run->key = key;
+    run->spec = parse_job_spec(json::parse(r.elements[0].str));
+    run->spec.params.threads = m_opt.threads;
+    run->base = scene_base(r.elements[1].str, run->spec.scene);
+    run->scene = pt::make_view(*run->base, run->spec.params);
+    run->features = feature_names(run->scene->features);
+    m_runs.push_front(std::move(run));
+    if (m_runs.size() > kRunsKept) m_runs.pop_back();
     return true;
+  }
+
+  // The built scene for a content hash: cached, or downloaded, parsed and built.
+  std::shared_ptr<const pt::SceneBase> scene_base(const std::string& hash, const std::string& name) {
+    for (auto it = m_bases.begin(); it != m_bases.end(); ++it)
+      if (it->first == hash) {
+        m_bases.splice(m_bases.begin(), m_bases, it);
+        return it->second;
+      }
+    RedisReply text = m_redis.command({"GET", rq::scene_key(hash)});
+    if (text.is_nil()) throw std::runtime_error("the scene of job '" + name + "' is no longer in Redis");
+    auto t0 = std::chrono::steady_clock::now();
+    auto base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(pt::parse_collada(text.str, name + ".dae")));
+    log("scene '%s' built in %.3f s", name.c_str(),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    m_bases.emplace_front(hash, base);
+    if (m_bases.size() > kBasesKept) m_bases.pop_back();  // views still rendering keep theirs alive
+    return base;
   }
 
   // Renders while a second connection keeps the pass claimed (so it is not taken over) and
@@ -186,13 +214,14 @@ class Worker {
       while (!cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return finished; }))
         if (g_stop) cancel = true;
     });
-    const pt::RenderParams& p = m_prepared.spec.params;
+    const PreparedRun& run = *m_runs.front();
+    const pt::RenderParams& p = run.spec.params;
     size_t n = size_t(p.cell_w > 0 ? p.cell_w : p.width) * size_t(p.cell_w > 0 ? p.cell_h : p.height);
     std::vector<uint8_t> skip = item.mask.empty() ? std::vector<uint8_t>() : pt::unpack_mask(item.mask, n);
     pt::FilmPass pass;
     std::exception_ptr failure;
     try {
-      pass = pt::render_film_pass(*m_prepared.scene, p, item.first, item.count, skip, &cancel, &complete);
+      pass = pt::render_film_pass(*run.scene, p, item.first, item.count, skip, &cancel, &complete);
     } catch (...) {
       failure = std::current_exception();
     }
@@ -221,7 +250,8 @@ class Worker {
   Options m_opt;
   RedisAddress m_address;
   RedisClient m_redis;
-  PreparedRun m_prepared;
+  std::list<std::unique_ptr<PreparedRun>> m_runs;  // most recent first
+  std::list<std::pair<std::string, std::shared_ptr<const pt::SceneBase>>> m_bases;
 };
 
 bool parse_options(int argc, char** argv, Options& o) {

@@ -2,7 +2,8 @@
 and three render-worker processes. A job renders through the workers; one worker is killed with
 SIGKILL while it holds a pass, another claims that pass, and the job still finishes with the image a
 single process renders (passes merge as sums of the same samples, so the two agree to float
-rounding). Cancel, the event stream and a failed scene behave as with the embedded queue."""
+rounding). Cancel and the event stream behave as with the embedded queue, and a worker builds a
+scene once for all the jobs that use its content."""
 import os
 import shutil
 import signal
@@ -180,3 +181,23 @@ def test_cancel_stops_the_workers(cluster):
         time.sleep(0.1)
     assert time.monotonic() - t0 < 20
     assert all(w.proc.poll() is None for w in workers), "a worker died"
+
+
+def test_a_worker_builds_a_scene_once_for_every_job_of_that_content(cluster):
+    srv, workers, redis = cluster(1)
+    # The same bytes under a second name: one content, one upload, one build.
+    shutil.copy(srv.scenes / "cornell.dae", srv.scenes / "cornell_copy.dae")
+    for scene, seed in (("cornell", 1), ("cornell_copy", 2), ("cornell", 3)):
+        job_id = srv.api.submit(dict(JOB, scene=scene, seed=seed, spp=4, width=64, height=48))["id"]
+        assert srv.api.wait(job_id, {"done", "failed"}, timeout=60)["state"] == "done"
+    builds = [line for line in workers[0].text().splitlines() if "built in" in line]
+    assert len(builds) == 1, f"the worker rebuilt a scene it had: {builds}"
+    scene_keys = [k for k in redis.cli("KEYS", "pt:scene:*").splitlines() if k]
+    assert len(scene_keys) == 1, scene_keys
+    # A different scene is built: the cache is keyed by content, not reused blindly.
+    text = (srv.scenes / "cornell.dae").read_text().replace("</COLLADA>", "<!-- edited --></COLLADA>")
+    (srv.scenes / "cornell_edited.dae").write_text(text)
+    job_id = srv.api.submit(dict(JOB, scene="cornell_edited", spp=4, width=64, height=48))["id"]
+    assert srv.api.wait(job_id, {"done", "failed"}, timeout=60)["state"] == "done"
+    builds = [line for line in workers[0].text().splitlines() if "built in" in line]
+    assert len(builds) == 2, builds
