@@ -444,7 +444,11 @@ class JobStateSink : public JobSink {
       j.has_image = true;
       j.elapsed = seconds();
     }
-    j.changed.notify_all();
+    // Every notify wakes every watcher, and each takes the job's mutex the render threads need:
+    // tile updates wake them at most every kTileNotifyGap (watchers batch tiles over 40 ms rounds
+    // anyway); pass() and state changes, which always follow the tiles, wake them at once.
+    int64_t now = std::chrono::steady_clock::now().time_since_epoch().count(), last = m_last_notify.load();
+    if (now - last >= kTileNotifyGap && m_last_notify.compare_exchange_strong(last, now)) j.changed.notify_all();
   }
 
   void pass(const RenderReport& r) override {
@@ -480,6 +484,9 @@ class JobStateSink : public JobSink {
   Job& m_job;
   std::function<void(Job&)> m_persist;
   std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last_persist = m_start;
+  static constexpr int64_t kTileNotifyGap =
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::milliseconds(20)).count();
+  std::atomic<int64_t> m_last_notify{0};
 };
 
 }  // namespace
