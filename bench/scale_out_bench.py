@@ -77,7 +77,8 @@ def run_job(build, tmp, spec, queue_url, workers, threads, label):
             p.wait(20)
         log.close()
     text = (tmp / f"server-{label}.log").read_text()
-    m = re.search(r"(\d+) passes merged in ([\d.]+) s \(([\d.]+) ms and ([\d.]+) MB a pass\)", text)
+    m = re.search(r"(\d+) passes merged in ([\d.]+) s \(([\d.]+) ms and ([\d.]+) MB a pass\).*spp a pass: ([\d ]+)",
+                  text)
     return seconds, job["samples"], m.groups() if m else None
 
 
@@ -104,19 +105,30 @@ def main():
           f"median of {a.runs} runs")
     print(f"{'setup':<14} {'seconds':>8} {'Msamples/s':>11} {'vs embedded':>12} {'passes':>7} {'merge ms/pass':>14} {'MB/pass':>8}")
     try:
-        baseline = None
-        for label, workers in [("embedded", 0), ("1 worker", 1), ("2 workers", 2), ("3 workers", 3)]:
-            runs = [run_job(build, tmp, spec, url if workers else None, workers, a.threads, label.replace(" ", "-"))
-                    for _ in range(a.runs)]
-            if sys.stderr.isatty():
-                sys.stderr.write("\r" + " " * 70 + "\r")
-            sec = statistics.median(r[0] for r in runs)
-            rate = runs[0][1] / sec / 1e6
+        setups = [("embedded", 0), ("1 worker", 1), ("2 workers", 2), ("3 workers", 3)]
+        runs = {label: [] for label, _ in setups}
+        for _ in range(a.runs):  # interleaved, so that the machine's drift spreads over every setup
+            for label, workers in setups:
+                runs[label].append(run_job(build, tmp, spec, url if workers else None, workers, a.threads,
+                                           label.replace(" ", "-")))
+        if sys.stderr.isatty():
+            sys.stderr.write("\r" + " " * 70 + "\r")
+        baseline, sizes = None, {}
+        for label, _ in setups:
+            sec = statistics.median(r[0] for r in runs[label])
+            rate = runs[label][0][1] / sec / 1e6
             baseline = baseline or rate
-            merge = runs[len(runs) // 2][2]
-            passes, merge_ms, mb = (merge[0], merge[2], merge[3]) if merge else ("-", "-", "-")
+            merges = [r[2] for r in runs[label] if r[2]]
+            passes, merge_ms, mb = "-", "-", "-"
+            if merges:
+                passes = merges[len(merges) // 2][0]
+                merge_ms = f"{statistics.median(float(m[2]) for m in merges):.2f}"
+                mb = merges[0][3]
+                sizes[label] = merges[-1][4].strip()
             print(f"{label:<14} {sec:8.2f} {rate:11.2f} {rate / baseline:11.2f}x {passes:>7} {merge_ms:>14} {mb:>8}",
                   flush=True)
+        for label, s in sizes.items():
+            print(f"spp a pass, {label}: {s}")
     finally:
         redis.kill()
         shutil.rmtree(tmp, ignore_errors=True)

@@ -47,6 +47,7 @@ class FilmAccumulator {
   // course's confidence test passed on the merged statistics.
   const std::vector<uint8_t>& done() const { return m_done; }
   bool finished() const { return m_remaining == 0; }
+  size_t remaining() const { return m_remaining; }  // pixels still taking samples
   double progress() const;
   double error_estimate() const;
   uint64_t samples() const { return m_samples; }

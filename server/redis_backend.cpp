@@ -27,20 +27,59 @@ std::string new_run_id() {
   return buf;
 }
 
-// Pass sizes: 1, 1, 2, 4, ... samples per pixel (quick first pictures; ranges aligned to powers
-// of two keep Sobol points well stratified within each pass), then a fixed size of about 2^21
-// pixel-samples, which takes a worker a fraction of a second to a few seconds.
-struct PassPlan {
-  std::vector<std::pair<uint32_t, uint32_t>> ranges;  // [first, first + count)
-  PassPlan(int spp, size_t pixels) {
-    uint32_t cap = 1;
-    while (cap < 1024 && double(cap) * 2 * pixels <= double(1 << 21)) cap *= 2;
-    for (uint32_t first = 0; first < uint32_t(spp);) {
-      uint32_t count = std::min(std::max(1u, std::min(cap, first)), uint32_t(spp) - first);
-      ranges.push_back({first, count});
-      first += count;
-    }
+// Pass sizes. The first passes are 1, 1, 2, 4, ... samples per pixel (quick first pictures), then
+// passes grow to what a worker renders in about kPassSeconds, measured from the passes returned,
+// and longer for large frames so that a worker sends at most kPassBytesPerSecond: the server's
+// merges and the network then cost the same per worker whatever the workers' speed
+// (docs/scale-out.md works out the numbers). A pass takes no more than an even share of the
+// remaining samples among the live workers (rounded up to a power of two), so that the last
+// passes of a job run side by side rather than one after another. Counts are
+// powers of two and ranges start at a multiple of their count, which keeps each pass's Sobol
+// points well stratified.
+constexpr double kPassSeconds = 2.0, kPassBytesPerSecond = 4e6;
+
+class PassPlan {
+ public:
+  PassPlan(int spp, size_t pixels) : m_spp(uint32_t(spp)), m_pixels(pixels) {}
+
+  bool exhausted() const { return m_next_first >= m_spp; }
+  size_t issued() const { return m_ranges.size(); }
+  std::pair<uint32_t, uint32_t> range(size_t unit) const { return m_ranges[unit]; }
+
+  // A returned pass: `samples` rendered in `seconds` by one worker.
+  void observe(uint64_t samples, double seconds) {
+    if (samples == 0 || !(seconds > 1e-3)) return;
+    double rate = samples / seconds;
+    m_rate = m_rate > 0 ? 0.5 * (m_rate + rate) : rate;
   }
+
+  // The next range, for `active` pixels still rendering and `workers` live workers.
+  std::pair<uint32_t, uint32_t> next(size_t active, int workers) {
+    uint32_t first = m_next_first, count = 1;
+    if (first > 0) {
+      uint32_t want = first, floor = 1;  // ramp: 1, 1, 2, 4, ... until a pass has been measured
+      if (m_rate > 0) {
+        double seconds = std::max(kPassSeconds, 20.0 * double(m_pixels) / kPassBytesPerSecond);
+        uint32_t timed = uint32_t(std::min(1024.0, std::max(1.0, m_rate * seconds / double(std::max<size_t>(active, 1)))));
+        want = std::min(timed, 2 * first);  // grow at most twofold a pass
+        floor = std::max(1u, timed / 4);    // the last passes shrink, but not to a trail of tiny ones
+      }
+      uint32_t share = 1, left = m_spp - first, n = uint32_t(std::max(1, workers));
+      while (share * n < left) share *= 2;  // an even share, rounded up
+      want = std::min(want, std::max(share, floor));
+      while (count * 2 <= want && first % (count * 2) == 0) count *= 2;
+    }
+    count = std::min(count, m_spp - first);
+    m_ranges.push_back({first, count});
+    m_next_first = first + count;
+    return m_ranges.back();
+  }
+
+ private:
+  uint32_t m_spp, m_next_first = 0;
+  size_t m_pixels;
+  double m_rate = 0;  // pixel-samples per second of one worker, smoothed
+  std::vector<std::pair<uint32_t, uint32_t>> m_ranges;
 };
 
 class RedisBackend : public RenderBackend {
@@ -102,8 +141,9 @@ class RedisBackend : public RenderBackend {
     for (int y = 0; y < h; y += p.tile_size)
       for (int x = 0; x < w; x += p.tile_size) tiles.push_back({x, y, std::min(x + p.tile_size, w), std::min(y + p.tile_size, h)});
 
-    size_t next = 0;  // the next pass to hand out
     std::set<uint32_t> merged;
+    int workers = 1;
+    auto next_worker_count = clock::now();
     bool started = false;
     std::string last_id = "0-0";
     double merge_seconds = 0;  // decoding, merging and publishing passes: the server's cost per pass
@@ -113,13 +153,18 @@ class RedisBackend : public RenderBackend {
     RenderResult result;
     redis.set_timeout(5.0);
     for (;;) {
-      // Keep a few passes queued ahead of the merges, each carrying the pixels converged so far.
-      while (next < plan.ranges.size() && next < merged.size() + size_t(m_in_flight) && !film.finished()) {
-        auto [first, count] = plan.ranges[next];
-        redis.command({"XADD", rq::kWorkStream, "*", "job", job.id, "run", run, "unit", std::to_string(next), "first",
-                       std::to_string(first), "count", std::to_string(count), "mask",
+      // Keep every live worker busy plus a few passes queued, each carrying the pixels converged
+      // so far. The worker count is looked up at most once a second.
+      if (clock::now() >= next_worker_count) {
+        workers = std::max(1, live_workers());
+        next_worker_count = clock::now() + std::chrono::seconds(1);
+      }
+      const size_t ahead = size_t(std::max(m_in_flight, workers + 2));
+      while (!plan.exhausted() && plan.issued() < merged.size() + ahead && !film.finished()) {
+        auto [first, count] = plan.next(film.remaining(), workers);
+        redis.command({"XADD", rq::kWorkStream, "*", "job", job.id, "run", run, "unit", std::to_string(plan.issued() - 1),
+                       "first", std::to_string(first), "count", std::to_string(count), "mask",
                        p.adaptive ? pt::pack_mask(film.done()) : std::string()});
-        ++next;
       }
       if (stop) {
         result.why = pt::StopReason::cancelled;
@@ -141,10 +186,13 @@ class RedisBackend : public RenderBackend {
         const std::string *unit = body.field("unit"), *bytes = body.field("pass");
         if (!unit || !bytes) continue;
         uint32_t u = uint32_t(std::strtoul(unit->c_str(), nullptr, 10));
-        if (u >= next || merged.count(u)) continue;  // a pass rendered twice (its first worker looked dead)
+        if (u >= plan.issued() || merged.count(u)) continue;  // a pass rendered twice (its first worker looked dead)
         pt::FilmPass pass = pt::FilmPass::decode(*bytes, w, h);
         pass_bytes += bytes->size();
-        if (pass.first != plan.ranges[u].first || pass.count != plan.ranges[u].second) continue;
+        if (pass.first != plan.range(u).first || pass.count != plan.range(u).second) continue;
+        uint64_t pass_samples = 0;
+        for (uint32_t n : pass.samples) pass_samples += n;
+        plan.observe(pass_samples, pass.seconds);
         if (!started) {
           std::vector<std::string> features;
           if (const std::string* f = body.field("features"))
@@ -174,7 +222,7 @@ class RedisBackend : public RenderBackend {
         result.why = pt::StopReason::target_error;
         break;
       }
-      if (film.finished() || merged.size() == plan.ranges.size()) {
+      if (film.finished() || (plan.exhausted() && merged.size() == plan.issued())) {
         result.why = pt::StopReason::finished;
         break;
       }
@@ -183,10 +231,13 @@ class RedisBackend : public RenderBackend {
     result.image = film.image();
     result.report = {film.progress(), film.samples(), film.rays(), film.nonfinite(), film.error_estimate()};
     result.seconds = elapsed();
-    if (!merged.empty())
-      std::fprintf(stderr, "render-server: job %s: %zu passes merged in %.3f s (%.2f ms and %.2f MB a pass), %.2f s in all\n",
+    if (!merged.empty()) {
+      std::string sizes;
+      for (size_t u = 0; u < plan.issued(); ++u) sizes += (u ? " " : "") + std::to_string(plan.range(u).second);
+      std::fprintf(stderr, "render-server: job %s: %zu passes merged in %.3f s (%.2f ms and %.2f MB a pass), %.2f s in all; spp a pass: %s\n",
                    job.id.c_str(), merged.size(), merge_seconds, 1e3 * merge_seconds / merged.size(),
-                   pass_bytes / 1e6 / merged.size(), result.seconds);
+                   pass_bytes / 1e6 / merged.size(), result.seconds, sizes.c_str());
+    }
     return result;
   }
 

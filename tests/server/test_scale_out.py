@@ -5,6 +5,7 @@ single process renders (passes merge as sums of the same samples, so the two agr
 rounding). Cancel and the event stream behave as with the embedded queue, and a worker builds a
 scene once for all the jobs that use its content."""
 import os
+import re
 import shutil
 import signal
 import socket
@@ -130,6 +131,11 @@ def test_killed_worker_loses_nothing_and_image_matches_single_process(cluster, s
     assert claimed, "no worker took over the killed worker's pass"
     left = [k for k in redis.cli("KEYS", f"pt:*:{job_id}:*").splitlines() if k]
     assert not left, f"the run's keys were not removed: {left}"
+    # Passes start at 1 spp for a quick first picture and grow once the workers' speed is known.
+    m = re.search(rf"job {job_id}: .*spp a pass: ([\d ]+)", srv.log_text())
+    assert m, "the server logged no merge summary"
+    sizes = [int(n) for n in m.group(1).split()]
+    assert sizes[:2] == [1, 1] and sum(sizes) == JOB["spp"] and max(sizes) >= 16, sizes
 
     # The same job on an embedded server: the same samples, so the same image up to float rounding.
     single = servers("single", threads=2)
