@@ -5,7 +5,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -62,6 +64,10 @@ struct Accel::Impl {
   std::vector<GeomInfo> geoms;  // indexed by Embree geometry id
   size_t bytes = 0;             // our side arrays (shading normals, per-triangle material and light)
   std::atomic<long long> embree_bytes{0};
+  // The scene's bounds, padded; a ray that misses them skips Embree (most camera rays of the
+  // course framing see only background). cull = false when the bounds are not finite.
+  float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  bool cull = false;
 
   void check(const char* what) {
     std::lock_guard<std::mutex> lock(error.mutex);
@@ -171,6 +177,23 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
 
   rtcCommitScene(a.scene);
   a.check("building the BVH");
+  RTCBounds b;
+  rtcGetSceneBounds(a.scene, &b);
+  const float blo[3] = {b.lower_x, b.lower_y, b.lower_z}, bhi[3] = {b.upper_x, b.upper_y, b.upper_z};
+  float size = 0;
+  bool finite = true;
+  for (int k = 0; k < 3; ++k) {
+    finite &= std::isfinite(blo[k]) && std::isfinite(bhi[k]) && blo[k] <= bhi[k];
+    size = std::max({size, std::fabs(blo[k]), std::fabs(bhi[k]), bhi[k] - blo[k]});
+  }
+  if (finite) {  // padded far beyond float rounding: culling must never drop a hit
+    float pad = 1e-3f * size + 1e-6f;
+    for (int k = 0; k < 3; ++k) {
+      a.lo[k] = blo[k] - pad;
+      a.hi[k] = bhi[k] + pad;
+    }
+    a.cull = true;
+  }
 }
 
 Accel::~Accel() = default;
@@ -203,6 +226,21 @@ inline bool embree_accepts(const Ray& r) {
          !std::isnan(r.tmin) && !std::isnan(r.tmax);
 }
 
+// Slab test (Kay & Kajiya, "Ray tracing complex scenes", SIGGRAPH 1986) of the ray's segment
+// against the scene bounds. A NaN from 0 * inf leaves the interval as it was: never a false miss.
+inline bool may_hit_bounds(const Ray& r, const float lo[3], const float hi[3]) {
+  const float o[3] = {r.o.x, r.o.y, r.o.z}, d[3] = {r.d.x, r.d.y, r.d.z};
+  float t0 = r.tmin, t1 = r.tmax;
+  for (int k = 0; k < 3; ++k) {
+    float inv = 1.0f / d[k];
+    float tn = (lo[k] - o[k]) * inv, tf = (hi[k] - o[k]) * inv;
+    if (tn > tf) std::swap(tn, tf);
+    t0 = tn > t0 ? tn : t0;
+    t1 = tf < t1 ? tf : t1;
+  }
+  return !(t0 > t1);
+}
+
 thread_local RayRecorder* t_recorder = nullptr;  // benchmarks only: see record_rays_on_this_thread
 
 // Out of line and cold, so the unset case stays one thread-local load and a branch.
@@ -218,6 +256,8 @@ void record_rays_on_this_thread(RayRecorder* r) { t_recorder = r; }
 bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(ray, 0);
   if (!embree_accepts(ray)) return false;
+  const Impl& a = *m_impl;
+  if (a.cull && !may_hit_bounds(ray, a.lo, a.hi)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;

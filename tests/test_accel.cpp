@@ -1,0 +1,130 @@
+// Ray queries against a brute-force reference: Accel skips Embree for rays that miss the scene's
+// bounds, and that shortcut must never drop a hit (rays grazing the bounds' faces, edges and
+// corners included) nor keep a miss from being one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "accel.h"
+
+using namespace pt;
+
+namespace {
+
+// A tilted quad (two triangles) and a sphere, far from the origin so that the bounds' padding is
+// tested at a large coordinate scale too.
+SceneDesc two_shapes(Vec3 offset) {
+  SceneDesc d;
+  d.materials.resize(1);
+  MeshDesc m;
+  m.positions = {offset + Vec3(-1, -1, 0.2f), offset + Vec3(1, -1, -0.2f), offset + Vec3(1, 1, 0.3f),
+                 offset + Vec3(-1, 1, -0.1f)};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  m.tri_material = {0, 0};
+  d.meshes.push_back(m);
+  SphereDesc s;
+  s.center = offset + Vec3(0.5f, 0.2f, 1.0f);
+  s.radius = 0.4f;
+  d.spheres.push_back(s);
+  return d;
+}
+
+// Double-precision reference: the nearest hit distance, or infinity; `clear` is false when the
+// ray passes within `margin` of a triangle edge or grazes the sphere (where float results may
+// legitimately differ).
+double reference_hit(const SceneDesc& d, const Ray& r, double margin, bool& clear) {
+  clear = true;
+  double best = INFINITY;
+  const MeshDesc& m = d.meshes[0];
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    Vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]], c = m.positions[m.indices[t + 2]];
+    double e1[3] = {b.x - a.x, b.y - a.y, b.z - a.z}, e2[3] = {c.x - a.x, c.y - a.y, c.z - a.z};
+    double dir[3] = {r.d.x, r.d.y, r.d.z}, s[3] = {r.o.x - a.x, r.o.y - a.y, r.o.z - a.z};
+    auto cross = [](const double* u, const double* v, double* o) {
+      o[0] = u[1] * v[2] - u[2] * v[1];
+      o[1] = u[2] * v[0] - u[0] * v[2];
+      o[2] = u[0] * v[1] - u[1] * v[0];
+    };
+    auto dot = [](const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+    double p[3], q[3];
+    cross(dir, e2, p);
+    double det = dot(e1, p);
+    if (std::fabs(det) < 1e-12) continue;
+    double u = dot(s, p) / det;
+    cross(s, e1, q);
+    double v = dot(dir, q) / det, tt = dot(e2, q) / det;
+    double w = 1 - u - v;
+    double edge = std::min({u, v, w});
+    if (std::fabs(edge) < margin) clear = false;
+    if (std::fabs(tt - r.tmax) < margin * (1 + tt)) clear = false;  // ends on the surface
+    if (edge >= 0 && tt > r.tmin && tt < r.tmax) best = std::min(best, tt);
+  }
+  const SphereDesc& sp = d.spheres[0];
+  double oc[3] = {r.o.x - sp.center.x, r.o.y - sp.center.y, r.o.z - sp.center.z};
+  double dd = double(r.d.x) * r.d.x + double(r.d.y) * r.d.y + double(r.d.z) * r.d.z;
+  double bb = oc[0] * r.d.x + oc[1] * r.d.y + oc[2] * r.d.z;
+  double cc = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - double(sp.radius) * sp.radius;
+  double disc = bb * bb - dd * cc;
+  if (std::fabs(disc) < margin * dd * sp.radius) clear = false;
+  if (disc >= 0) {
+    // Both roots: a ray starting inside the sphere hits its far side.
+    for (double root : {(-bb - std::sqrt(disc)) / dd, (-bb + std::sqrt(disc)) / dd}) {
+      if (std::fabs(root - r.tmin) < margin || std::fabs(root - r.tmax) < margin * (1 + root)) clear = false;
+      if (root > r.tmin && root < r.tmax) {
+        best = std::min(best, root);
+        break;
+      }
+    }
+  }
+  return best;
+}
+
+void check_against_reference(Vec3 offset) {
+  SceneDesc d = two_shapes(offset);
+  Accel accel(d, {}, {});
+  Bounds3 b = d.geometry_bounds();
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  int hits = 0, misses = 0, compared = 0;
+  for (int i = 0; i < 200000; ++i) {
+    // Targets on and just around the bounds (faces, edges, corners), origins all around.
+    Vec3 target;
+    for (int k = 0; k < 3; ++k) {
+      float lo = b.lo[k], hi = b.hi[k], x = u(rng);
+      float pick = x < 0.3f ? lo : x < 0.6f ? hi : lo + (hi - lo) * u(rng);
+      target[k] = pick + (u(rng) - 0.5f) * 0.02f;
+    }
+    Vec3 dir = normalize(Vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f));
+    Ray r;
+    r.o = target - dir * (2 + 6 * u(rng));
+    r.d = dir * (0.5f + u(rng));  // unnormalised directions too
+    r.tmin = 0;
+    r.tmax = u(rng) < 0.5f ? kInf : 4 + 8 * u(rng);
+    bool clear;
+    double ref = reference_hit(d, r, 1e-4, clear);
+    if (!clear) continue;
+    ++compared;
+    SurfaceHit hit;
+    bool got = accel.intersect(r, hit);
+    ASSERT_EQ(got, std::isfinite(ref)) << "ray " << i << " from " << r.o.x << "," << r.o.y << "," << r.o.z;
+    if (got) {
+      EXPECT_NEAR(hit.t, ref, 1e-3 * (1 + ref));
+      ++hits;
+    } else {
+      ++misses;
+    }
+  }
+  // Both outcomes well represented, or the comparison says little.
+  EXPECT_GT(hits, 20000);
+  EXPECT_GT(misses, 20000);
+  EXPECT_GT(compared, 150000);
+}
+
+}  // namespace
+
+TEST(Accel, AgreesWithBruteForceAroundTheSceneBoundsNearTheOrigin) { check_against_reference(Vec3(0, 0, 0)); }
+
+TEST(Accel, AgreesWithBruteForceAroundTheSceneBoundsFarFromTheOrigin) {
+  check_against_reference(Vec3(3000, -2000, 1000));
+}
