@@ -1,0 +1,117 @@
+// Exports a scene as our renderer sees it, for bench/vs_mitsuba.py: the geometry after our loader
+// (world-space triangles, split by material, as binary PLY; spheres as spheres), the materials,
+// the lights and the comparison framing's camera (the course's view at 480x360, keep_fov), as one
+// JSON file the script turns into a Mitsuba 3 scene dictionary. Kinds Mitsuba's comparison does
+// not need (point, spot, directional, ambient lights) are refused with a message, never skipped.
+//
+//   ./build/bench_export_mitsuba scene.dae OUT_DIR [--width 480 --height 360]
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "bench_common.h"
+#include "camera.h"
+#include "collada.h"
+
+namespace {
+
+using nlohmann::json;
+using pt::Vec3;
+
+json vec(Vec3 v) { return json::array({v.x, v.y, v.z}); }
+
+void write_ply(const std::string& path, const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw std::runtime_error(path + ": cannot write");
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << positions.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << indices.size() / 3
+      << "\nproperty list uchar int vertex_indices\nend_header\n";
+  out.write(reinterpret_cast<const char*>(positions.data()), std::streamsize(positions.size() * sizeof(Vec3)));
+  for (size_t t = 0; t < indices.size(); t += 3) {
+    unsigned char three = 3;
+    int32_t idx[3] = {int32_t(indices[t]), int32_t(indices[t + 1]), int32_t(indices[t + 2])};
+    out.write(reinterpret_cast<const char*>(&three), 1);
+    out.write(reinterpret_cast<const char*>(idx), sizeof idx);
+  }
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+json material_json(const pt::Material& m) {
+  json j = {{"name", m.name}, {"type", pt::material_type_name(m.type)}, {"albedo", vec(m.albedo)},
+            {"transmittance", vec(m.transmittance)}, {"ior", m.ior}, {"alpha", m.alpha}, {"eta", vec(m.eta)},
+            {"k", vec(m.k)}, {"radiance", vec(m.radiance)}};
+  return j;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: %s scene.dae OUT_DIR [--width W --height H]\n", argv[0]);
+    return 2;
+  }
+  try {
+    bench::Args args(argc, argv);
+    int width = args.integer("--width", 480), height = args.integer("--height", 360);
+    std::string scene_path = argv[1], out_dir = argv[2];
+    args.used[1] = args.used[2] = true;
+    args.finish("scene.dae OUT_DIR [--width W --height H]");
+    pt::SceneDesc desc = pt::load_collada(scene_path);
+
+    json scene;
+    pt::CameraParams cp;
+    cp.width = width;
+    cp.height = height;
+    cp.keep_fov = true;
+    pt::Camera cam = pt::make_camera(desc, cp);
+    scene["camera"] = {{"origin", vec(cam.position)}, {"target", vec(cam.position - cam.back)}, {"up", vec(cam.up)},
+                       {"fov_x_deg", 2 * std::atan(cam.tan_half_w) * 180 / M_PI},
+                       {"fov_y_deg", 2 * std::atan(cam.tan_half_h) * 180 / M_PI},
+                       {"width", width}, {"height", height}};
+    scene["materials"] = json::array();
+    for (const pt::Material& m : desc.materials) scene["materials"].push_back(material_json(m));
+
+    // Triangles per (mesh, material), so that each Mitsuba shape has one BSDF.
+    scene["meshes"] = json::array();
+    for (size_t mi = 0; mi < desc.meshes.size(); ++mi) {
+      const pt::MeshDesc& mesh = desc.meshes[mi];
+      std::map<int, std::vector<uint32_t>> by_material;
+      for (size_t t = 0; t < mesh.indices.size() / 3; ++t)
+        for (int c = 0; c < 3; ++c) by_material[mesh.tri_material[t]].push_back(mesh.indices[3 * t + c]);
+      for (auto& [material, indices] : by_material) {
+        std::string file = "mesh" + std::to_string(mi) + "_m" + std::to_string(material) + ".ply";
+        write_ply(out_dir + "/" + file, mesh.positions, indices);
+        scene["meshes"].push_back({{"file", file}, {"material", material}, {"smooth", !mesh.normals.empty()}});
+      }
+    }
+    scene["spheres"] = json::array();
+    for (const pt::SphereDesc& s : desc.spheres)
+      scene["spheres"].push_back({{"center", vec(s.center)}, {"radius", s.radius}, {"material", s.material}});
+    scene["area_lights"] = json::array();
+    for (const pt::LightDesc& l : desc.lights) {
+      if (l.type != pt::LightType::area)
+        throw std::runtime_error(scene_path + ": light '" + l.name + "' is a " + pt::light_type_name(l.type) +
+                                 " light; the Mitsuba export handles area lights only");
+      // Mitsuba's rectangle emits along +z of its frame: order the edges so x cross y faces the
+      // light's direction.
+      Vec3 x = l.dim_x * 0.5f, y = l.dim_y * 0.5f, n = pt::normalize(l.direction);
+      if (pt::dot(pt::cross(x, y), n) < 0) std::swap(x, y);
+      scene["area_lights"].push_back({{"center", vec(l.position)}, {"half_x", vec(x)}, {"half_y", vec(y)},
+                                      {"normal", vec(n)}, {"radiance", vec(l.color)}});
+    }
+    std::ofstream out(out_dir + "/scene.json");
+    out << scene.dump(1) << "\n";
+    if (!out) throw std::runtime_error(out_dir + "/scene.json: write failed");
+    std::printf("%s: %zu mesh parts, %zu spheres, %zu area lights -> %s/scene.json\n", scene_path.c_str(),
+                scene["meshes"].size(), desc.spheres.size(), desc.lights.size(), out_dir.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_export_mitsuba: %s\n", e.what());
+    return 1;
+  }
+}
