@@ -52,8 +52,89 @@ struct GeomInfo {
   std::vector<Vec3> normals;          // shading normals, empty for flat meshes
   std::vector<TriangleInfo> tris;     // per triangle
   const float* spheres = nullptr;     // x y z r per sphere
+  std::vector<float> sphere_data;     // what `spheres` points to (Embree user geometry reads it)
   std::vector<int> sphere_material;
 };
+
+// Spheres are Embree user geometry with this analytic test, not RTC_GEOMETRY_TYPE_SPHERE_POINT:
+// Embree's sphere points are built for many small spheres (point clouds), and on the course's few
+// large spheres they cost more than a scalar quadratic. The roots follow Haines et al., "Precision
+// Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7 (2019): the discriminant from
+// the distance of the centre to the ray line, and the smaller root from c / q, which avoid the
+// cancellation of the textbook formula far from the sphere and for rays that graze it.
+inline bool sphere_roots(const float* s, float ox, float oy, float oz, float dx, float dy, float dz, float& t0,
+                         float& t1) {
+  float fx = ox - s[0], fy = oy - s[1], fz = oz - s[2], r = s[3];
+  float a = dx * dx + dy * dy + dz * dz;
+  float b = -(fx * dx + fy * dy + fz * dz);  // b' = -f.d
+  float k = b / a;
+  float lx = fx + k * dx, ly = fy + k * dy, lz = fz + k * dz;  // centre-to-line offset
+  float disc = a * (r * r - (lx * lx + ly * ly + lz * lz));
+  if (!(disc >= 0) || !(a > 0)) return false;
+  float c = fx * fx + fy * fy + fz * fz - r * r;
+  float q = b + std::copysign(std::sqrt(disc), b);
+  t0 = q != 0 ? c / q : 0;
+  t1 = q / a;
+  if (t0 > t1) std::swap(t0, t1);
+  return true;
+}
+
+void sphere_bounds(const RTCBoundsFunctionArguments* args) {
+  const float* s = static_cast<const float*>(args->geometryUserPtr) + 4 * args->primID;
+  RTCBounds* b = args->bounds_o;
+  b->lower_x = s[0] - s[3];
+  b->lower_y = s[1] - s[3];
+  b->lower_z = s[2] - s[3];
+  b->upper_x = s[0] + s[3];
+  b->upper_y = s[1] + s[3];
+  b->upper_z = s[2] + s[3];
+}
+
+void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
+  const float* s = static_cast<const float*>(args->geometryUserPtr) + 4 * args->primID;
+  RTCRayHitN* rh = args->rayhit;
+  RTCRayN* ray = RTCRayHitN_RayN(rh, args->N);
+  RTCHitN* hit = RTCRayHitN_HitN(rh, args->N);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    float t0, t1;
+    if (!sphere_roots(s, RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i), RTCRayN_org_z(ray, args->N, i),
+                      RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i), RTCRayN_dir_z(ray, args->N, i),
+                      t0, t1))
+      continue;
+    float tnear = RTCRayN_tnear(ray, args->N, i), &tfar = RTCRayN_tfar(ray, args->N, i);
+    float t = t0 > tnear ? t0 : t1;
+    if (!(t > tnear && t < tfar)) continue;
+    tfar = t;
+    float px = RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i);
+    float py = RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i);
+    float pz = RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i);
+    RTCHitN_Ng_x(hit, args->N, i) = px - s[0];
+    RTCHitN_Ng_y(hit, args->N, i) = py - s[1];
+    RTCHitN_Ng_z(hit, args->N, i) = pz - s[2];
+    RTCHitN_u(hit, args->N, i) = 0;
+    RTCHitN_v(hit, args->N, i) = 0;
+    RTCHitN_primID(hit, args->N, i) = args->primID;
+    RTCHitN_geomID(hit, args->N, i) = args->geomID;
+    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+  }
+}
+
+void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
+  const float* s = static_cast<const float*>(args->geometryUserPtr) + 4 * args->primID;
+  RTCRayN* ray = args->ray;
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    float t0, t1;
+    if (!sphere_roots(s, RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i), RTCRayN_org_z(ray, args->N, i),
+                      RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i), RTCRayN_dir_z(ray, args->N, i),
+                      t0, t1))
+      continue;
+    float tnear = RTCRayN_tnear(ray, args->N, i), &tfar = RTCRayN_tfar(ray, args->N, i);
+    float t = t0 > tnear ? t0 : t1;
+    if (t > tnear && t < tfar) tfar = -INFINITY;
+  }
+}
 
 }  // namespace
 
@@ -151,26 +232,24 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
   }
 
   if (!desc.spheres.empty()) {
-    RTCGeometry g = rtcNewGeometry(a.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                           4 * sizeof(float), desc.spheres.size()));
-    a.check("allocating sphere buffer");
+    RTCGeometry g = rtcNewGeometry(a.device, RTC_GEOMETRY_TYPE_USER);
     GeomInfo info;
     info.kind = GeomKind::spheres;
-    for (size_t i = 0; i < desc.spheres.size(); ++i) {
-      const SphereDesc& s = desc.spheres[i];
-      vb[4 * i + 0] = s.center.x;
-      vb[4 * i + 1] = s.center.y;
-      vb[4 * i + 2] = s.center.z;
-      vb[4 * i + 3] = s.radius;
+    for (const SphereDesc& s : desc.spheres) {
+      info.sphere_data.insert(info.sphere_data.end(), {s.center.x, s.center.y, s.center.z, s.radius});
       info.sphere_material.push_back(s.material);
     }
-    a.bytes += desc.spheres.size() * sizeof(int);
+    info.spheres = info.sphere_data.data();  // stays valid when info moves into a.geoms
+    a.bytes += desc.spheres.size() * (4 * sizeof(float) + sizeof(int));
+    rtcSetGeometryUserPrimitiveCount(g, unsigned(desc.spheres.size()));
+    rtcSetGeometryUserData(g, const_cast<float*>(info.spheres));
+    rtcSetGeometryBoundsFunction(g, sphere_bounds, nullptr);
+    rtcSetGeometryIntersectFunction(g, sphere_intersect);
+    rtcSetGeometryOccludedFunction(g, sphere_occluded);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a.scene, g);
     rtcReleaseGeometry(g);
     a.check("attaching spheres");
-    info.spheres = vb;
     if (a.geoms.size() <= id) a.geoms.resize(id + 1);
     a.geoms[id] = std::move(info);
   }
