@@ -277,6 +277,13 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
 
 Accel::~Accel() = default;
 
+bool Accel::hit_bounds(Vec3& lo, Vec3& hi) const {
+  const Impl& a = *m_impl;
+  lo = Vec3(a.lo[0], a.lo[1], a.lo[2]);
+  hi = Vec3(a.hi[0], a.hi[1], a.hi[2]);
+  return a.cull;
+}
+
 size_t Accel::memory_bytes() const {
   return m_impl->bytes + size_t(std::max(0LL, m_impl->embree_bytes.load()));
 }

@@ -46,6 +46,9 @@ class Accel {
   // Bytes held for rendering: everything Embree allocated (BVH, vertex and index buffers, as its
   // memory monitor reports) plus our per-triangle shading data.
   size_t memory_bytes() const;
+  // The box every hit lies in (the scene bounds, padded as the miss shortcut pads them); false when
+  // the bounds are not finite (nothing may be assumed about misses then).
+  bool hit_bounds(Vec3& lo, Vec3& hi) const;
 
   // Benchmarks only (bench/ceiling.cpp; the renderer never calls it): casts rays[0, n) straight
   // through Embree, rtcIntersect1 / rtcOccluded1 per ray when batch <= 1, else Embree's stream API

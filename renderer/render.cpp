@@ -253,6 +253,33 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
   int ts = params.tile_size;
   for (int y = 0; y < m_h; y += ts)
     for (int x = 0; x < m_w; x += ts) m_tiles.push_back({x, y, std::min(x + ts, m_w), std::min(y + ts, m_h)});
+  find_scene_rectangle();
+}
+
+// Where the scene's (padded) bounding box projects on the sensor of a pinhole camera in front of
+// it. The box is convex and wholly in front, so every ray that can hit it passes inside the box
+// spanned by its eight projected corners; a pixel wholly outside (with a pixel of margin) sees only
+// background. Without an environment seen by the camera, background is exactly black and the
+// path loop would stop at its first, missed query: the sample is black and counts one ray.
+void RenderSession::find_scene_rectangle() {
+  const Camera& cam = m_scene.camera;
+  Vec3 lo, hi;
+  if (cam.lens_radius > 0 || m_scene.environment_light >= 0 || !m_scene.accel || !m_scene.accel->hit_bounds(lo, hi))
+    return;
+  if (!(cam.tan_half_w > 0) || !(cam.tan_half_h > 0)) return;
+  float u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf;
+  for (int c = 0; c < 8; ++c) {
+    Vec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+    Vec3 v = corner - cam.position;
+    float z = -dot(v, cam.back);
+    if (!(z > 1e-3f * length(v))) return;  // a corner beside or behind the camera: no rectangle
+    float u = (dot(v, cam.right) / (z * cam.tan_half_w) + 1) * 0.5f * float(m_params.width);
+    float w = (dot(v, cam.up) / (z * cam.tan_half_h) + 1) * 0.5f * float(m_params.height);
+    if (!std::isfinite(u) || !std::isfinite(w)) return;
+    u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, w), v1 = std::max(v1, w);
+  }
+  m_scene_u0 = u0 - 1, m_scene_u1 = u1 + 1, m_scene_v0 = v0 - 1, m_scene_v1 = v1 + 1;
+  m_background_rect = true;
 }
 
 void RenderSession::render_tile(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,
@@ -270,15 +297,21 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
       int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
       int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
       uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
+      const bool background = sees_only_background(fx, fy_up);
       uint32_t before = m_count[i];
       while (m_count[i] < uint32_t(target)) {
         uint32_t s = m_count[i];
         if ((s & 15) == 15 && stop_requested(cancel)) break;
-        Sampler rng(p.sampler, p.seed, pixel_index, m_first_sample + s);
-        Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
-        Vec2 lens = cam.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};  // a pinhole needs none
-        Ray ray = cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
-        Vec3 l = trace(m_scene, p, ray, rng, rays);
+        Vec3 l(0.0f);
+        if (background) {
+          ++rays;  // the camera ray the path loop would have cast and missed
+        } else {
+          Sampler rng(p.sampler, p.seed, pixel_index, m_first_sample + s);
+          Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
+          Vec2 lens = cam.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};  // a pinhole needs none
+          Ray ray = cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
+          l = trace(m_scene, p, ray, rng, rays);
+        }
         if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
           ++nonfinite;
           l = Vec3(0.0f);

@@ -159,8 +159,14 @@ class RenderSession {
   const std::vector<Vec3>& pixel_sums() const { return m_sum; }
   const std::vector<double>& pixel_lum2_sums() const { return m_s2; }
   const std::vector<uint32_t>& pixel_counts() const { return m_count; }
+  // True when every camera ray of frame pixel (fx, fy_up) (y up, as the course counts rows) misses
+  // the scene, so that its samples are black without a ray query (see find_scene_rectangle).
+  bool sees_only_background(int fx, int fy_up) const {
+    return m_background_rect && (fx + 1 < m_scene_u0 || fx > m_scene_u1 || fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1);
+  }
 
  private:
+  void find_scene_rectangle();
   void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
                    uint64_t& samples, uint64_t& nonfinite);
 
@@ -168,6 +174,11 @@ class RenderSession {
   RenderParams m_params;
   int m_w, m_h;            // film size (the cell for -p)
   int m_frame_x0, m_frame_y0;  // film origin inside the full frame, top-left
+  // Pixels whose every camera ray misses the scene (frame pixel coordinates, y up): outside this
+  // rectangle a sample is black and costs no ray query. Off (empty) for a thin lens or a visible
+  // environment.
+  bool m_background_rect = false;
+  float m_scene_u0 = 0, m_scene_u1 = 0, m_scene_v0 = 0, m_scene_v1 = 0;
   uint32_t m_first_sample = 0;
   std::vector<Tile> m_tiles;
   std::vector<Vec3> m_sum;
