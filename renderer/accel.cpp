@@ -313,17 +313,21 @@ inline bool embree_accepts(const Ray& r) {
 }
 
 // Slab test (Kay & Kajiya, "Ray tracing complex scenes", SIGGRAPH 1986) of the ray's segment
-// against the scene bounds. A NaN from 0 * inf leaves the interval as it was: never a false miss.
+// against the scene bounds. Rays that start inside the box (every bounce in a closed scene) pass at
+// once; the rest run the slabs unrolled and branch-free. A NaN from 0 * inf leaves the interval as
+// it was: never a false miss.
 inline bool may_hit_bounds(const Ray& r, const float lo[3], const float hi[3]) {
-  const float o[3] = {r.o.x, r.o.y, r.o.z}, d[3] = {r.d.x, r.d.y, r.d.z};
-  float t0 = r.tmin, t1 = r.tmax;
-  for (int k = 0; k < 3; ++k) {
-    float inv = 1.0f / d[k];
-    float tn = (lo[k] - o[k]) * inv, tf = (hi[k] - o[k]) * inv;
-    if (tn > tf) std::swap(tn, tf);
-    t0 = tn > t0 ? tn : t0;
-    t1 = tf < t1 ? tf : t1;
-  }
+  if (r.o.x >= lo[0] && r.o.x <= hi[0] && r.o.y >= lo[1] && r.o.y <= hi[1] && r.o.z >= lo[2] && r.o.z <= hi[2])
+    return true;
+  const float ix = 1.0f / r.d.x, iy = 1.0f / r.d.y, iz = 1.0f / r.d.z;
+  const float ax = (lo[0] - r.o.x) * ix, bx = (hi[0] - r.o.x) * ix;
+  const float ay = (lo[1] - r.o.y) * iy, by = (hi[1] - r.o.y) * iy;
+  const float az = (lo[2] - r.o.z) * iz, bz = (hi[2] - r.o.z) * iz;
+  // max/min written so that a NaN operand yields the other one (the interval is left as it was).
+  auto mx = [](float a, float b) { return a > b ? a : b; };
+  auto mn = [](float a, float b) { return a < b ? a : b; };
+  float t0 = mx(mx(mx(r.tmin, mn(ax, bx)), mn(ay, by)), mn(az, bz));
+  float t1 = mn(mn(mn(r.tmax, mx(ax, bx)), mx(ay, by)), mx(az, bz));
   return !(t0 > t1);
 }
 
