@@ -7,19 +7,27 @@
 
 namespace pt {
 
-// Cosine-weighted hemisphere around +z via Shirley-Chiu concentric disk mapping.
+// cos and sin of a in [-pi/4, pi/4] by Taylor polynomials (degree 8 and 7): errors below 3e-8 and
+// 3e-7, under a float's rounding of the results near 1; much cheaper than sincosf's range reduction.
+inline void sincos_quarter(float a, float& s, float& c) {
+  float a2 = a * a;
+  s = a * (1 + a2 * (-1.0f / 6 + a2 * (1.0f / 120 + a2 * (-1.0f / 5040))));
+  c = 1 + a2 * (-0.5f + a2 * (1.0f / 24 + a2 * (-1.0f / 720 + a2 * (1.0f / 40320))));
+}
+
+// Cosine-weighted hemisphere around +z via Shirley-Chiu concentric disk mapping ("A Low
+// Distortion Map Between Disk and Square", 1997). Its angle is pi/4 * ratio or pi/2 minus that,
+// so one quarter-range sin/cos pair serves both wedges.
 inline Vec2 sample_concentric_disk(Vec2 u) {
   float ox = 2 * u.x - 1, oy = 2 * u.y - 1;
   if (ox == 0 && oy == 0) return {0, 0};
-  float r, theta;
+  float s, c;
   if (std::fabs(ox) > std::fabs(oy)) {
-    r = ox;
-    theta = (kPi / 4) * (oy / ox);
-  } else {
-    r = oy;
-    theta = kPi / 2 - (kPi / 4) * (ox / oy);
+    sincos_quarter((kPi / 4) * (oy / ox), s, c);
+    return {ox * c, ox * s};  // theta = a
   }
-  return {r * std::cos(theta), r * std::sin(theta)};
+  sincos_quarter((kPi / 4) * (ox / oy), s, c);
+  return {oy * s, oy * c};  // theta = pi/2 - a: cos(theta) = sin(a), sin(theta) = cos(a)
 }
 inline Vec3 sample_cosine_hemisphere(Vec2 u) {
   Vec2 d = sample_concentric_disk(u);
