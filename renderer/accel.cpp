@@ -90,22 +90,26 @@ void sphere_bounds(const RTCBoundsFunctionArguments* args) {
   b->upper_z = s[2] + s[3];
 }
 
+// Ray i of a ray packet against sphere s: the nearest root inside (tnear, tfar), if any.
+inline bool sphere_hit(const float* s, RTCRayN* ray, unsigned N, unsigned i, float& t) {
+  float t0, t1;
+  if (!sphere_roots(s, RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i),
+                    RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i), t0, t1))
+    return false;
+  float tnear = RTCRayN_tnear(ray, N, i);
+  t = t0 > tnear ? t0 : t1;
+  return t > tnear && t < RTCRayN_tfar(ray, N, i);
+}
+
 void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
   const float* s = static_cast<const float*>(args->geometryUserPtr) + 4 * args->primID;
   RTCRayHitN* rh = args->rayhit;
   RTCRayN* ray = RTCRayHitN_RayN(rh, args->N);
   RTCHitN* hit = RTCRayHitN_HitN(rh, args->N);
   for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    float t0, t1;
-    if (!sphere_roots(s, RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i), RTCRayN_org_z(ray, args->N, i),
-                      RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i), RTCRayN_dir_z(ray, args->N, i),
-                      t0, t1))
-      continue;
-    float tnear = RTCRayN_tnear(ray, args->N, i), &tfar = RTCRayN_tfar(ray, args->N, i);
-    float t = t0 > tnear ? t0 : t1;
-    if (!(t > tnear && t < tfar)) continue;
-    tfar = t;
+    float t;
+    if (args->valid[i] != -1 || !sphere_hit(s, ray, args->N, i, t)) continue;
+    RTCRayN_tfar(ray, args->N, i) = t;
     float px = RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i);
     float py = RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i);
     float pz = RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i);
@@ -124,15 +128,8 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   const float* s = static_cast<const float*>(args->geometryUserPtr) + 4 * args->primID;
   RTCRayN* ray = args->ray;
   for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    float t0, t1;
-    if (!sphere_roots(s, RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i), RTCRayN_org_z(ray, args->N, i),
-                      RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i), RTCRayN_dir_z(ray, args->N, i),
-                      t0, t1))
-      continue;
-    float tnear = RTCRayN_tnear(ray, args->N, i), &tfar = RTCRayN_tfar(ray, args->N, i);
-    float t = t0 > tnear ? t0 : t1;
-    if (t > tnear && t < tfar) tfar = -INFINITY;
+    float t;
+    if (args->valid[i] == -1 && sphere_hit(s, ray, args->N, i, t)) RTCRayN_tfar(ray, args->N, i) = -INFINITY;
   }
 }
 

@@ -161,18 +161,8 @@ double FilmAccumulator::progress() const {
 }
 
 double FilmAccumulator::error_estimate() const {
-  // As RenderSession::error_estimate, with the two halves made of whole passes.
-  double sum = 0;
-  size_t used = 0;
-  for (size_t i = 0; i < m_count.size(); ++i) {
-    uint32_t n = m_count[i], p = m_half_n[i];
-    if (n < 2 || p == 0 || p >= n) continue;
-    double a = m_half_s1[i] / p, b = (m_s1[i] - m_half_s1[i]) / (n - p), mu = m_s1[i] / n;
-    double var_mean = (a - b) * (a - b) * double(p) * double(n - p) / (double(n) * n);
-    sum += var_mean / (mu * mu + kRelMseEpsilon);
-    ++used;
-  }
-  return used ? sum / double(m_count.size()) : INFINITY;
+  // As the session's, with the two halves made of whole passes.
+  return halves_error_estimate(m_count, m_half_n, m_s1, m_half_s1);
 }
 
 ImageRGB FilmAccumulator::image() const {

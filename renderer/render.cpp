@@ -474,24 +474,30 @@ void RenderSession::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const 
     for (int x = t.x0; x < t.x1; ++x) out.push_back(rate_colour(m_count[size_t(y) * m_w + x], m_params.spp));
 }
 
-double RenderSession::error_estimate() const {
+double halves_error_estimate(const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
+                             const std::vector<double>& s1, const std::vector<double>& half_s1) {
   // Relative MSE of the pixel means: mean over pixels of Var[mean] / (mean^2 + eps) (relMSE as in
   // Rousselle et al. 2011, eps keeping black pixels finite). Var[mean] comes from comparing the
-  // mean A of samples [0, P) with the mean B of [P, n), P the last power of two below n:
+  // mean A of samples [0, P) with the mean B of [P, n):
   // E[(A - B)^2] P (n - P) / n^2 = sigma^2 / n for independent samples, and unlike the sample
   // variance it also sees the faster convergence of stratified (Sobol) samples, each half of
   // which is itself well stratified.
   double sum = 0;
   size_t used = 0;
-  for (size_t i = 0; i < m_count.size(); ++i) {
-    uint32_t n = m_count[i], p = m_half_n[i];
+  for (size_t i = 0; i < count.size(); ++i) {
+    uint32_t n = count[i], p = half_n[i];
     if (n < 2 || p == 0 || p >= n) continue;
-    double a = m_half_s1[i] / p, b = (m_s1[i] - m_half_s1[i]) / (n - p), mu = m_s1[i] / n;
+    double a = half_s1[i] / p, b = (s1[i] - half_s1[i]) / (n - p), mu = s1[i] / n;
     double var_mean = (a - b) * (a - b) * double(p) * double(n - p) / (double(n) * n);
     sum += var_mean / (mu * mu + kRelMseEpsilon);
     ++used;
   }
-  return used ? sum / double(m_count.size()) : INFINITY;
+  return used ? sum / double(count.size()) : INFINITY;
+}
+
+double RenderSession::error_estimate() const {
+  // P, the first half's size, is the last power of two below n.
+  return halves_error_estimate(m_count, m_half_n, m_s1, m_half_s1);
 }
 
 SessionStats RenderSession::stats() const {

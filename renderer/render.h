@@ -111,6 +111,11 @@ Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, c
 using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class Sampler&, uint64_t&);
 PathTracer path_tracer_for(uint32_t feature_bits);
 
+// The error estimate both the session and the scale-out's merged film report: from per-pixel
+// sample counts n, luminance sums s1, and the count and sum of a first part of each pixel's samples.
+double halves_error_estimate(const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
+                             const std::vector<double>& s1, const std::vector<double>& half_s1);
+
 struct Tile {
   int x0, y0, x1, y1;  // film pixels, top-left origin, half-open
 };
