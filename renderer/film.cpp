@@ -139,11 +139,8 @@ void FilmAccumulator::merge(const FilmPass& pass) {
     if (m_done[i]) continue;
     bool done = n >= uint32_t(m_params.spp);
     // The course's test (95% confidence half-width within tolerance x mean), on merged sums.
-    if (!done && m_params.adaptive && n > uint32_t(batch)) {
-      double mu = m_s1[i] / n;
-      double var = std::max(0.0, (m_s2[i] - m_s1[i] * m_s1[i] / n) / (n - 1));
-      done = 1.96 * std::sqrt(var / n) <= m_params.adaptive_tolerance * mu;
-    }
+    if (!done && m_params.adaptive && n > uint32_t(batch))
+      done = confidence_reached(m_s1[i], m_s2[i], n, m_params.adaptive_tolerance);
     if (done) {
       m_done[i] = 1;
       --m_remaining;

@@ -328,13 +328,9 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
         ++samples;
         // Course adaptive sampling: after sample index n-1 > 0 that is a multiple of the batch,
         // stop once the 95% confidence half-width is within tolerance x mean.
-        if (adaptive && n > 1 && (n - 1) % batch == 0) {
-          double mu = m_s1[i] / n;
-          double var = std::max(0.0, (m_s2[i] - m_s1[i] * m_s1[i] / n) / (n - 1));
-          if (1.96 * std::sqrt(var / n) <= p.adaptive_tolerance * mu) {
-            m_done[i] = 1;
-            break;
-          }
+        if (adaptive && n > 1 && (n - 1) % batch == 0 && confidence_reached(m_s1[i], m_s2[i], n, p.adaptive_tolerance)) {
+          m_done[i] = 1;
+          break;
         }
       }
       if (m_count[i] >= uint32_t(p.spp)) m_done[i] = 1;

@@ -2,8 +2,10 @@
 // the progressive, cancellable render session that the CLI, the server and the window share.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -110,6 +112,15 @@ Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, c
 // The path loop specialised for a set of feature bits (one instantiation per combination).
 using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class Sampler&, uint64_t&);
 PathTracer path_tracer_for(uint32_t feature_bits);
+
+// The course's adaptive-sampling test for one pixel with n > 1 luminance samples of sum s1 and
+// sum of squares s2: the 95% confidence half-width is within tolerance x mean. Shared by the
+// session and the scale-out's merged film.
+inline bool confidence_reached(double s1, double s2, uint32_t n, double tolerance) {
+  double mu = s1 / n;
+  double var = std::max(0.0, (s2 - s1 * s1 / n) / (n - 1));
+  return 1.96 * std::sqrt(var / n) <= tolerance * mu;
+}
 
 // The error estimate both the session and the scale-out's merged film report: from per-pixel
 // sample counts n, luminance sums s1, and the count and sum of a first part of each pixel's samples.
