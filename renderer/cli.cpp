@@ -72,6 +72,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--no-adaptive") { p.adaptive = false; }
     else if (a == "--keep-fov") { p.keep_fov = true; }
     else if (a == "--generic") { p.generic = true; }
+    else if (a == "--no-caustic-tracing") { p.caustic_tracing = false; }
     else if (a == "--sampler") {
       need(a, 1);
       std::string v = args[++i];
@@ -139,6 +140,7 @@ std::string usage_text(const std::string& program) {
 "  --keep-fov      -r scales the course's 800x600 view to the output size instead of cropping it\n"
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
 "  --generic       run the path loop with every feature (for comparisons with the specialised one)\n"
+"  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"
 "\n"
 "Error against run time:\n"
@@ -188,6 +190,7 @@ Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
           {"pathtracer:focal_distance", num(p.focal_distance)},
           {"pathtracer:adaptive", p.adaptive ? std::to_string(p.adaptive_batch) + " " + num(p.adaptive_tolerance) : "off"},
           {"pathtracer:direct", p.hemisphere ? "hemisphere" : "light sampling"},
+          {"pathtracer:caustic_light_paths", std::to_string(st.light_paths)},
           {"pathtracer:environment", p.env_map},
           {"pathtracer:seed", std::to_string(p.seed)},
           {"pathtracer:threads", std::to_string(p.threads)},

@@ -85,6 +85,7 @@ FilmPass render_film_pass(const RenderScene& scene, const RenderParams& params, 
                           const std::vector<uint8_t>& skip, const std::atomic<bool>* cancel, bool* complete) {
   RenderParams p = params;
   p.adaptive = false;  // convergence is judged on the merged statistics, not per pass
+  p.caustic_tracing = false;  // light-traced splats do not split by sample range: paths carry caustics
   RenderSession session(scene, p);
   session.set_sample_range(first, skip);
   bool ok = session.render_pass(int(count), cancel);

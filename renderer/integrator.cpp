@@ -116,6 +116,9 @@ template <uint32_t F>
 Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray, Sampler& rng, uint64_t& rays) {
   Vec3 radiance(0.0f), beta(1.0f);
   bool specular = true;  // the camera ray counts as specular: emitters it sees get full weight
+  // Where the path stands against the light tracer's share (caustics.h), paths E D+ S+ L: non-delta
+  // vertices only so far (1), then delta bounces only (2), or neither (0).
+  int caustic_phase = 0;
   float prev_pdf = 0;
   Vec3 prev_p;
   int depth_left = params.max_depth;
@@ -142,7 +145,10 @@ Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray,
     Vec3 wo_world = -ray.d;
     if (material.type == MaterialType::emission) {
       Vec3 le = emitted_radiance(material, Vec3(0, 0, dot(wo_world, hit.ng)));
-      if (!is_black(le)) {
+      bool light_traced = false;
+      if constexpr ((F & kFeatDelta) != 0)
+        light_traced = params.caustics_light_traced && caustic_phase == 2 && hit.light >= 0;
+      if (!is_black(le) && !light_traced) {
         float w = 1;
         if (!specular) {
           if (params.hemisphere) w = 0;
@@ -185,6 +191,9 @@ Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray,
     beta *= bs.weight;
     if (is_black(beta) || !is_finite(beta)) break;
     specular = bs.delta;
+    if (bounce == 0) caustic_phase = bs.delta ? 0 : 1;
+    else if (caustic_phase == 1 && bs.delta) caustic_phase = 2;
+    else if (caustic_phase == 2 && !bs.delta) caustic_phase = 0;
     prev_pdf = bs.pdf;
     prev_p = hit.p;
     --depth_left;

@@ -32,6 +32,7 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
   std::printf("shading normals:  %s\n", f.shading_normals ? "yes (curved meshes)" : "no (flat shading)");
   std::printf("camera:           %s\n", f.thin_lens ? "thin lens" : "pinhole");
   std::printf("adaptive:         %s\n", f.adaptive ? "on" : "off (spp <= batch, or --no-adaptive)");
+  std::printf("caustics:         %s\n", f.caustic_tracing ? "light traced" : "path traced only");
   std::printf("path loop:        %s%s%s%s\n", f.bits == kFeatAll ? "generic" : "specialised:",
               f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),

@@ -14,6 +14,7 @@
 
 #include "accel.h"
 #include "camera.h"
+#include "caustics.h"
 #include "image.h"
 #include "lights.h"
 #include "sampler.h"
@@ -42,6 +43,10 @@ struct RenderParams {
   int tile_size = 32;
   bool generic = false;            // --generic: the path loop with every feature (for comparisons)
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
+  bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
+  // Set by RenderSession, not by users: its light tracer renders the caustic paths (caustics.h),
+  // so the path loop leaves them out.
+  bool caustics_light_traced = false;
 
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;
@@ -59,6 +64,7 @@ struct SceneFeatures {
   std::vector<std::string> materials, lights;
   bool spheres = false, meshes = false, environment = false, thin_lens = false;
   bool adaptive = false, shading_normals = false;
+  bool caustic_tracing = false;  // caustics by light tracing (caustics.h)
   uint32_t bits = kFeatAll;  // which specialised path loop runs
 };
 
@@ -73,6 +79,7 @@ struct SceneBase {
   size_t triangle_count = 0, sphere_count = 0;
   CameraDesc camera;                // what make_camera reads of the file
   Bounds3 bounds;
+  std::vector<CausticTarget> caustic_targets;  // bounds of the delta-material geometry
   std::string source;
 
   // Bytes held for rendering: BVH and geometry (Accel::memory_bytes), lights, materials.
@@ -89,6 +96,10 @@ struct RenderScene {
   Camera camera;
   SceneFeatures features;
   size_t triangle_count = 0, sphere_count = 0;
+  // What the caustic light tracer samples: delta geometry to aim at, area and mesh lights by power.
+  std::vector<CausticTarget> caustic_targets;
+  std::vector<int> caustic_lights;
+  Distribution1D caustic_light_distribution;
 };
 
 // Builds what the integrator needs from the file's description: lights (area lights also as
@@ -124,8 +135,16 @@ inline bool confidence_reached(double s1, double s2, uint32_t n, double toleranc
 
 // The error estimate both the session and the scale-out's merged film report: from per-pixel
 // sample counts n, luminance sums s1, and the count and sum of a first part of each pixel's samples.
+// Light-traced splats (caustics.h) add their own variance, estimated the same way from the
+// per-pixel splat luminance sums of n light paths and of the first half_n of them.
+struct SplatStats {
+  const std::vector<double>* s1 = nullptr;
+  const std::vector<double>* half_s1 = nullptr;
+  uint64_t n = 0, half_n = 0;
+};
 double halves_error_estimate(const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
-                             const std::vector<double>& s1, const std::vector<double>& half_s1);
+                             const std::vector<double>& s1, const std::vector<double>& half_s1,
+                             const SplatStats& splats = {});
 
 struct Tile {
   int x0, y0, x1, y1;  // film pixels, top-left origin, half-open
@@ -133,6 +152,7 @@ struct Tile {
 
 struct SessionStats {
   uint64_t samples = 0, rays = 0, nonfinite = 0;
+  uint64_t light_paths = 0;  // caustic light paths traced (caustics.h)
   double seconds = 0;
   int passes = 0;
 };
@@ -158,6 +178,8 @@ class RenderSession {
   double progress() const;
   ImageRGB image() const;        // mean radiance per pixel
   ImageRGB rate_image() const;   // the course's sample-rate colouring
+  // The light-traced caustics alone (caustics.h), part of image(); black when they are path traced.
+  ImageRGB caustic_image() const;
   // Estimated relative MSE of the image, without a reference (see render.cpp).
   double error_estimate() const;
   SessionStats stats() const;
@@ -183,6 +205,8 @@ class RenderSession {
 
  private:
   void find_scene_rectangle();
+  void trace_caustics(int target_spp, const std::atomic<bool>* cancel);
+  Vec3 pixel_mean(size_t i) const;
   void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
                    uint64_t& samples, uint64_t& nonfinite);
 
@@ -195,6 +219,7 @@ class RenderSession {
   // environment.
   bool m_background_rect = false;
   float m_scene_u0 = 0, m_scene_u1 = 0, m_scene_v0 = 0, m_scene_v1 = 0;
+  double m_scene_pixels = 0;  // the projected bounds' area, unclipped (0: unknown)
   uint32_t m_first_sample = 0;
   std::vector<Tile> m_tiles;
   std::vector<Vec3> m_sum;
@@ -205,6 +230,12 @@ class RenderSession {
   std::vector<uint32_t> m_half_n;
   std::vector<uint32_t> m_count;
   std::vector<uint8_t> m_done;
+  // Caustics by light tracing (caustics.h): per-pixel splat sums over m_lt_paths light paths, their
+  // luminance, and the luminance sums at the last halving (as m_half_s1 for camera samples).
+  CausticFilm m_caustic_film;
+  std::vector<Vec3> m_lt_sum;
+  std::vector<double> m_lt_s1, m_lt_half_s1;
+  uint64_t m_lt_paths = 0, m_lt_half_paths = 0, m_lt_issued = 0;
   std::atomic<uint64_t> m_samples{0}, m_rays{0}, m_nonfinite{0};
   std::atomic<uint64_t> m_budget_done{0};  // pixel-samples done, converged pixels counted in full
   double m_seconds = 0;

@@ -86,6 +86,7 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   p.hemisphere = r.boolean("hemisphere", false);
   p.file_camera = r.boolean("file_camera", false);
   p.keep_fov = r.boolean("keep_fov", false);
+  p.caustic_tracing = r.boolean("caustic_tracing", true);
   p.tile_size = int(r.integer("tile_size", 32, 8, 256));
   s.time_limit = r.number("time_limit", 0, 0, 7 * 86400);
   s.target_error = r.number("target_error", 0, 0, 1);
@@ -135,6 +136,7 @@ json job_spec_to_json(const JobSpec& s) {
               {"hemisphere", p.hemisphere},
               {"file_camera", p.file_camera},
               {"keep_fov", p.keep_fov},
+              {"caustic_tracing", p.caustic_tracing},
               {"tile_size", p.tile_size},
               {"time_limit", s.time_limit},
               {"target_error", s.target_error}};
@@ -153,6 +155,7 @@ std::vector<std::string> feature_names(const pt::SceneFeatures& f) {
   if (f.environment) out.push_back("environment map");
   if (f.thin_lens) out.push_back("thin lens");
   if (f.adaptive) out.push_back("adaptive sampling");
+  if (f.caustic_tracing) out.push_back("caustic light tracing");
   return out;
 }
 

@@ -24,6 +24,7 @@ struct Fixture {
     params.threads = 2;
     params.seed = 11;
     params.tile_size = 16;
+    params.caustic_tracing = false;  // film passes render caustics by path tracing alone
     SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
     scene = make_render_scene(desc, params);
   }

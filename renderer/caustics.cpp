@@ -1,0 +1,221 @@
+// Caustic light paths (see caustics.h for the split with the path tracer).
+#include "caustics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <thread>
+
+#include "accel.h"
+#include "materials.h"
+#include "render.h"
+#include "sampler.h"
+
+namespace pt {
+
+namespace {
+
+// Light paths use the sample streams of pixels no film has (the Sobol index is 32 bits; the
+// high bits of the path index pick the pseudo-pixel).
+constexpr uint64_t kLightPathPixel = 0xC0FFEE0000000000ull;
+// From this many delta bounces on, light paths play Russian roulette (as camera paths do).
+constexpr int kRouletteStart = 5;
+
+// Uniform sampling of the cone of directions from p that can reach a sphere (PBRT 3rd ed.,
+// 13.6.4 "Sampling a cone"); a point inside the sphere sees the whole sphere of directions.
+struct Cone {
+  Vec3 axis;
+  float cos_max = -1;  // -1: every direction
+  float solid_angle = 4 * kPi;
+};
+
+Cone cone_towards(Vec3 p, const CausticTarget& t) {
+  Cone c;
+  Vec3 d = t.center - p;
+  float dist2 = length_squared(d);
+  if (!(dist2 > t.radius * t.radius)) {
+    c.axis = Vec3(0, 0, 1);
+    return c;
+  }
+  float dist = std::sqrt(dist2);
+  c.axis = d / dist;
+  float sin2 = t.radius * t.radius / dist2;
+  c.cos_max = std::sqrt(std::max(0.0f, 1 - sin2));
+  // 1 - cos_max without cancellation for far, small targets.
+  float one_minus = sin2 / (1 + c.cos_max);
+  c.solid_angle = 2 * kPi * one_minus;
+  return c;
+}
+
+Vec3 sample_cone(const Cone& c, Vec2 u) {
+  if (c.cos_max <= -1) return sample_uniform_sphere(u);
+  float cos_t = 1 - u.x * (1 - c.cos_max);
+  float sin_t = std::sqrt(std::max(0.0f, 1 - cos_t * cos_t));
+  float phi = 2 * kPi * u.y;
+  Frame f(c.axis);
+  return f.to_world(Vec3(std::cos(phi) * sin_t, std::sin(phi) * sin_t, cos_t));
+}
+
+// Connects the path's first non-delta vertex to the pinhole and splats what the camera sees
+// there. Light arrives along `arriving` (pointing into the surface) with flux weight `beta`.
+void splat_to_camera(const RenderScene& scene, const CausticFilm& film,
+                     const SurfaceHit& hit, const Material& m, Vec3 arriving, Vec3 beta,
+                     std::vector<CausticSplat>& out, uint64_t& rays) {
+  const Camera& cam = scene.camera;
+  Vec3 v = hit.p - cam.position;
+  float dist2 = length_squared(v), dist = std::sqrt(dist2);
+  float z = -dot(v, cam.back);
+  if (!(z > 0) || !(dist > 0) || dist < cam.tmin || dist > cam.tmax) return;
+  float sx = (dot(v, cam.right) / (z * cam.tan_half_w) + 1) * 0.5f;
+  float sy = (dot(v, cam.up) / (z * cam.tan_half_h) + 1) * 0.5f;
+  if (!(sx >= 0 && sx < 1 && sy >= 0 && sy < 1)) return;
+  int fx = std::min(int(sx * film.frame_w), film.frame_w - 1);
+  int fy_up = std::min(int(sy * film.frame_h), film.frame_h - 1);
+  int x = fx - film.x0, y = (film.frame_h - 1 - fy_up) - film.y0;
+  if (x < 0 || y < 0 || x >= film.w || y >= film.h) return;
+
+  // The path tracer's shading frame at its first vertex: opaque, normals turned to the viewer.
+  Vec3 wo_world = -v / dist, wi_world = -arriving;
+  Vec3 ng = hit.ng, ns = hit.ns;
+  if (dot(wo_world, ng) < 0) {
+    ng = -ng;
+    ns = -ns;
+  }
+  if (dot(wo_world, ns) <= 0) ns = ng;
+  float cos_wi_g = dot(wi_world, ng), cos_wo_g = dot(wo_world, ng);
+  if (cos_wi_g <= 0 || cos_wo_g <= 0) return;  // the path tracer bounces on the viewer's side only
+  Frame frame(ns);
+  Vec3 wi = frame.to_local(wi_world);
+  Vec3 f = eval_bsdf(m, frame.to_local(wo_world), wi);
+  if (is_black(f)) return;
+  ++rays;
+  if (scene.accel->occluded(spawn_ray_to(hit, cam.position))) return;
+
+  // Pixel value = W H / (4 tan_w tan_h) x the integral over visible area of L cos_x / (r^2 cos^3);
+  // the flux estimate carries cos at the surface w.r.t. the true normal, the path tracer's
+  // L_o uses the shading cosine |wi.z| (Veach 1997, 5.3, adjoint shading normals).
+  float cos_cam = z / dist;
+  float k = float(film.frame_w) * float(film.frame_h) / (4 * cam.tan_half_w * cam.tan_half_h);
+  Vec3 value = beta * f * (std::fabs(wi.z) / cos_wi_g * cos_wo_g * k / (dist2 * cos_cam * cos_cam * cos_cam));
+  if (is_finite(value) && !is_black(value)) out.push_back({uint32_t(size_t(y) * film.w + x), value});
+}
+
+}  // namespace
+
+std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std::vector<Material>& materials) {
+  std::vector<CausticTarget> out;
+  // Padding keeps grazing hits inside the cones despite rounding.
+  auto padded = [](Vec3 c, float r) { return CausticTarget{c, r * 1.001f + 1e-6f * max_component(abs(c))}; };
+  for (const SphereDesc& s : desc.spheres)
+    if (is_delta(materials[s.material])) out.push_back(padded(s.center, s.radius));
+  for (const MeshDesc& mesh : desc.meshes) {
+    Bounds3 b;
+    for (size_t t = 0; t < mesh.tri_material.size(); ++t)
+      if (is_delta(materials[mesh.tri_material[t]]))
+        for (int k = 0; k < 3; ++k) b.expand(mesh.positions[mesh.indices[3 * t + k]]);
+    if (!b.empty()) out.push_back(padded(b.center(), 0.5f * length(b.diagonal())));
+  }
+  return out;
+}
+
+bool caustic_tracing_applies(const RenderScene& scene, const RenderParams& params) {
+  return params.caustic_tracing && !params.hemisphere && params.spp > 1 && params.max_depth >= 2 &&
+         scene.camera.lens_radius <= 0 && !scene.caustic_targets.empty() && !scene.caustic_lights.empty();
+}
+
+void trace_caustic_path(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
+                        uint64_t index, std::vector<CausticSplat>& out, uint64_t& rays) {
+  Sampler rng(params.sampler, params.seed, kLightPathPixel + (index >> 32), uint32_t(index));
+  // A point on a light chosen by power, uniform by area.
+  Vec2 u_light = rng.next_2d(), u_point = rng.next_2d();
+  float p_light, u_reuse;
+  size_t li = scene.caustic_light_distribution.sample_discrete(u_light.x, &p_light, &u_reuse);
+  const Light& light = scene.lights[scene.caustic_lights[li]];
+  Vec3 x0, n;
+  if (light.kind == LightKind::rect) {
+    x0 = light.position + light.dim_x * (u_point.x - 0.5f) + light.dim_y * (u_point.y - 0.5f);
+    n = light.direction;
+  } else {
+    float prob, ux;
+    size_t t = light.triangle_distribution.sample_discrete(u_point.x, &prob, &ux);
+    Vec2 b = sample_uniform_triangle({ux, u_point.y});
+    const Vec3* v = &light.triangles[3 * t];
+    x0 = v[0] * b.x + v[1] * b.y + v[2] * (1 - b.x - b.y);
+    n = normalize(cross(v[1] - v[0], v[2] - v[0]));
+  }
+
+  // A direction into the cone of one target, chosen in proportion to the cones' solid angles: the
+  // pdf is the number of cones holding the direction over their total solid angle.
+  constexpr size_t kMaxTargets = 64;
+  Cone cones[kMaxTargets];
+  size_t nt = std::min(scene.caustic_targets.size(), kMaxTargets);
+  float total = 0;
+  for (size_t k = 0; k < nt; ++k) total += (cones[k] = cone_towards(x0, scene.caustic_targets[k])).solid_angle;
+  Vec2 u_dir = rng.next_2d();
+  float pick = rng.next_float() * total;
+  size_t chosen = 0;
+  while (chosen + 1 < nt && pick >= cones[chosen].solid_angle) pick -= cones[chosen++].solid_angle;
+  Vec3 wi = sample_cone(cones[chosen], u_dir);
+  float cos_l = dot(wi, n);
+  if (!(cos_l > 0)) return;  // emitters are one-sided
+  int holding = 0;
+  for (size_t k = 0; k < nt; ++k) holding += (k == chosen || dot(wi, cones[k].axis) >= cones[k].cos_max);
+  float pdf_dir = float(holding) / total;
+  Vec3 beta = light.color * (cos_l * light.area / (p_light * pdf_dir));
+  if (!is_finite(beta)) return;
+
+  Ray ray;
+  ray.o = offset_ray_origin(x0, n);
+  ray.d = wi;
+  ray.tmin = 0;
+  ray.tmax = kInf;
+  Vec3 throughput(1.0f);
+  int delta_bounces = 0, diffuse_vertices = 0;
+  for (int vertex = 1;; ++vertex) {  // the path tracer's count: at most max_depth vertices
+    SurfaceHit hit;
+    ++rays;
+    if (!scene.accel->intersect(ray, hit)) return;
+    const Material& m = scene.materials[hit.material];
+    if (m.type == MaterialType::emission) return;  // emitters reflect nothing
+    const bool delta = is_delta(m);
+    // Ours are L S+ D+ E: a first non-delta vertex ends a path with no delta bounce, and a delta
+    // one after the diffuse part ends it too (the path tracer renders both).
+    if (delta ? diffuse_vertices > 0 : delta_bounces == 0) return;
+    if (!delta) {
+      splat_to_camera(scene, film, hit, m, ray.d, beta, out, rays);
+      ++diffuse_vertices;
+    } else {
+      ++delta_bounces;
+    }
+    if (vertex + 1 > params.max_depth) return;  // no room for another vertex
+    Vec3 wo_world = -ray.d, ng = hit.ng, ns = hit.ns;
+    bool transmissive = is_transmissive(m);
+    if (!transmissive && dot(wo_world, ng) < 0) {
+      ng = -ng;
+      ns = -ns;
+    }
+    if (!transmissive && dot(wo_world, ns) <= 0) ns = ng;
+    Frame frame(ns);
+    float u_lobe = rng.next_float();
+    Vec2 u = rng.next_2d();
+    BsdfSample bs;
+    if (!sample_bsdf(m, frame.to_local(wo_world), u_lobe, u, bs)) return;
+    Vec3 wi_world = frame.to_world(bs.wi);
+    if (!transmissive && dot(wi_world, ng) <= 0) return;
+    // Importance transport through a shading normal (Veach 1997, eq. 5.19).
+    float den = std::fabs(dot(wo_world, ng)) * std::fabs(dot(wi_world, ns));
+    if (!(den > 0)) return;
+    float correction = std::fabs(dot(wo_world, ns)) * std::fabs(dot(wi_world, ng)) / den;
+    throughput *= bs.weight * correction;
+    beta *= bs.weight * correction;
+    if (is_black(beta) || !is_finite(beta)) return;
+    if (vertex >= kRouletteStart) {
+      float q = std::min(0.95f, max_component(throughput));
+      if (rng.next_float() >= q) return;
+      beta /= q;
+      throughput /= q;
+    }
+    ray = spawn_ray(hit, wi_world);
+  }
+}
+
+}  // namespace pt

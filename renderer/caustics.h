@@ -1,0 +1,58 @@
+// Caustics by light tracing: the paths light -> specular chain -> diffuse surface -> camera.
+//
+// A path tracer finds these paths only when a BSDF-sampled direction from the diffuse point
+// happens to reach the (small) light through the specular chain, which makes them the bulk of the
+// noise in scenes with glass and mirrors. Traced from the light instead (Veach 1997, section 10.2,
+// "light tracing"), each such path reaches the camera by one connection. The two methods split
+// the paths between them, so their sum is unbiased:
+// - the path tracer drops emitter hits of area and mesh lights reached by one or more delta
+//   bounces straight after the first camera vertex when that vertex is not delta;
+// - the light tracer produces exactly those paths: it leaves an area or mesh light, follows delta
+//   bounces only, and at the first non-delta surface connects to the camera and stops.
+// Light paths are aimed at bounding spheres of the delta geometry (a directional pdf over the cones
+// they subtend), since every other direction starts a path the path tracer keeps.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "math.h"
+
+namespace pt {
+
+struct Material;
+struct RenderParams;
+struct RenderScene;
+struct SceneDesc;
+
+// A sphere that bounds geometry with a delta material: what light paths are aimed at.
+struct CausticTarget {
+  Vec3 center;
+  float radius = 0;
+};
+
+// One bounding sphere per sphere with a delta material and one per mesh for its delta triangles.
+std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std::vector<Material>& materials);
+
+// Whether a view of the scene with these options renders caustics by light tracing: it needs a
+// delta material, an area or mesh light, a pinhole camera, more than one sample per pixel (one
+// sample is the pixel centre, which splats cannot match), and light sampling (not -H).
+bool caustic_tracing_applies(const RenderScene& scene, const RenderParams& params);
+
+// Where on the film a point is seen: the full frame and the film window inside it (top-left).
+struct CausticFilm {
+  int frame_w = 0, frame_h = 0;
+  int x0 = 0, y0 = 0, w = 0, h = 0;
+};
+
+struct CausticSplat {
+  uint32_t pixel;  // film index, row-major from the top-left
+  Vec3 value;      // to be divided by the number of light paths
+};
+
+// Traces light path `index` (its random numbers depend only on the seed and the index) and
+// appends the splats it makes. Counts its rays in `rays`.
+void trace_caustic_path(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
+                        uint64_t index, std::vector<CausticSplat>& out, uint64_t& rays);
+
+}  // namespace pt

@@ -1,0 +1,171 @@
+// Caustics by light tracing (renderer/caustics.h): the light tracer and the path tracer split the
+// caustic paths between them, so the image converges to the path tracer's alone; the light tracer
+// applies only where it can; images stay independent of the thread count.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "collada.h"
+#include "materials.h"
+#include "render.h"
+#include "test_util.h"
+
+namespace pt {
+namespace {
+
+RenderParams cornell_params() {
+  RenderParams p;
+  p.width = 64;
+  p.height = 48;
+  p.spp = 64;
+  p.max_depth = 4;
+  p.adaptive = false;
+  p.threads = 2;
+  p.keep_fov = true;  // the whole view: a crop of the course's 800x600 view gets few splats
+  return p;
+}
+
+// Independent renders (seeds) of one setting: per 16x16 block the mean luminance and its standard
+// error, and the estimator's true relative variance per pixel (across seeds, as relMSE weighs it).
+struct SeedStats {
+  std::vector<double> mean, stderr_;
+  double rel_variance = 0;
+  uint64_t light_paths = 0;
+  ImageRGB caustics;  // the first seed's light-traced part
+};
+constexpr int kBlock = 16;
+
+std::vector<double> block_means(const ImageRGB& img) {
+  std::vector<double> out;
+  for (int by = 0; by + kBlock <= img.height; by += kBlock)
+    for (int bx = 0; bx + kBlock <= img.width; bx += kBlock)
+      out.push_back(test::region_stats(img, bx, by, bx + kBlock, by + kBlock).mean);
+  return out;
+}
+
+SeedStats over_seeds(const SceneDesc& desc, RenderParams p, int seeds) {
+  SeedStats st;
+  std::vector<std::vector<double>> blocks;
+  std::vector<double> s1, s2;
+  for (int s = 0; s < seeds; ++s) {
+    p.seed = uint64_t(100 + s);
+    auto scene = make_render_scene(desc, p);
+    RenderSession session(*scene, p);
+    EXPECT_TRUE(session.render_all());
+    ImageRGB img = session.image();
+    blocks.push_back(block_means(img));
+    s1.resize(img.pixels.size()), s2.resize(img.pixels.size());
+    for (size_t i = 0; i < img.pixels.size(); ++i) {
+      double l = luminance(img.pixels[i]);
+      s1[i] += l, s2[i] += l * l;
+    }
+    if (s == 0) st.caustics = session.caustic_image();
+    st.light_paths += session.stats().light_paths;
+  }
+  for (size_t k = 0; k < blocks[0].size(); ++k) {
+    double a = 0, b = 0;
+    for (const auto& r : blocks) a += r[k], b += r[k] * r[k];
+    double m = a / seeds, var = std::max(0.0, (b - a * a / seeds) / (seeds - 1));
+    st.mean.push_back(m);
+    st.stderr_.push_back(std::sqrt(var / seeds));
+  }
+  for (size_t i = 0; i < s1.size(); ++i) {
+    double m = s1[i] / seeds, var = std::max(0.0, (s2[i] - s1[i] * s1[i] / seeds) / (seeds - 1));
+    st.rel_variance += var / (m * m + kRelMseEpsilon) / double(s1.size());
+  }
+  return st;
+}
+
+class CausticSplit : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    SceneDesc desc = load_collada(test::own_scene("cornell.dae"));  // mirror and glass spheres, area light
+    RenderParams p = cornell_params();
+    p.spp = 256;
+    split = new SeedStats(over_seeds(desc, p, 10));
+    p.caustic_tracing = false;
+    alone = new SeedStats(over_seeds(desc, p, 10));
+  }
+  static void TearDownTestSuite() {
+    delete split;
+    delete alone;
+  }
+  static SeedStats* split;  // light-traced caustics
+  static SeedStats* alone;  // path tracing alone
+};
+SeedStats* CausticSplit::split = nullptr;
+SeedStats* CausticSplit::alone = nullptr;
+
+TEST_F(CausticSplit, SplitWithThePathTracerConvergesToThePathTracersImage) {
+  // The light tracer carries a share of some block far above the noise: were its paths lost,
+  // counted twice, or their splats 25% off, that block would be off by over 6 standard errors.
+  std::vector<double> share = block_means(split->caustics);
+  double most = 0;
+  for (size_t k = 0; k < share.size(); ++k) {
+    double noise = std::hypot(split->stderr_[k], alone->stderr_[k]);
+    EXPECT_LE(std::fabs(split->mean[k] - alone->mean[k]), 4.5 * noise + 1e-5)
+        << "block " << k << ": with light tracing " << split->mean[k] << " +- " << split->stderr_[k]
+        << ", path tracing alone " << alone->mean[k] << " +- " << alone->stderr_[k];
+    most = std::max(most, share[k] / (noise + 1e-9));
+  }
+  EXPECT_GT(most, 25) << "the light-traced caustics must be a share of the image well above its noise";
+  std::printf("largest light-traced share of a block: %.1f standard errors\n", most);
+}
+
+TEST_F(CausticSplit, LightTracingRemovesMostOfTheCausticNoise) {
+  EXPECT_GT(split->light_paths, 0u);
+  EXPECT_EQ(alone->light_paths, 0u);
+  // True variance across seeds (the path tracer's own estimate misses rare caustic paths).
+  EXPECT_LT(split->rel_variance, 0.6 * alone->rel_variance) << split->rel_variance << " vs " << alone->rel_variance;
+  std::printf("relative variance per pixel: %.4g with light tracing, %.4g without\n", split->rel_variance, alone->rel_variance);
+}
+
+TEST(Caustics, SameImageAtAnyThreadCount) {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  RenderParams p = cornell_params();
+  p.spp = 8;
+  p.threads = 1;
+  auto scene = make_render_scene(desc, p);
+  RenderSession one(*scene, p);
+  one.render_all();
+  p.threads = 3;
+  RenderSession three(*scene, p);
+  three.render_all();
+  ImageRGB a = one.image(), b = three.image();
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  for (size_t i = 0; i < a.pixels.size(); ++i) ASSERT_EQ(a.pixels[i], b.pixels[i]) << i;
+  EXPECT_GT(one.stats().light_paths, 0u);
+}
+
+TEST(Caustics, AppliesOnlyWhereItCan) {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  auto applies = [&](RenderParams p) {
+    auto scene = make_render_scene(desc, p);
+    return scene->features.caustic_tracing;
+  };
+  RenderParams p = cornell_params();
+  EXPECT_TRUE(applies(p));
+  RenderParams q = p;
+  q.caustic_tracing = false;
+  EXPECT_FALSE(applies(q));
+  q = p;
+  q.lens_radius = 0.05f;  // splats would need the lens
+  EXPECT_FALSE(applies(q));
+  q = p;
+  q.spp = 1;  // one sample is the pixel centre
+  EXPECT_FALSE(applies(q));
+  q = p;
+  q.hemisphere = true;
+  EXPECT_FALSE(applies(q));
+  q = p;
+  q.max_depth = 1;  // no room for a delta bounce
+  EXPECT_FALSE(applies(q));
+  // Without delta materials there is nothing to aim at.
+  SceneDesc diffuse = desc;
+  for (Material& m : diffuse.materials)
+    if (is_delta(m)) m.type = MaterialType::diffuse;
+  EXPECT_FALSE(make_render_scene(diffuse, p)->features.caustic_tracing);
+}
+
+}  // namespace
+}  // namespace pt
