@@ -274,17 +274,22 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
   find_scene_rectangle();
 }
 
-// Where the scene's (padded) bounding box projects on the sensor of a pinhole camera in front of
-// it. The box is convex and wholly in front, so every ray that can hit it passes inside the box
+// Where the scene's (padded) bounding box projects on the sensor of a camera in front of it. The
+// box is convex and wholly in front, so every pinhole ray that can hit it passes inside the box
 // spanned by its eight projected corners; a pixel wholly outside (with a pixel of margin) sees only
 // background. Without an environment seen by the camera, background is exactly black and the
 // path loop would stop at its first, missed query: the sample is black and counts one ray.
+// A thin lens sees a point at depth z from lens point l at sensor position p/z - l (1/z - 1/f)
+// (camera.cpp's ray through the focus point p f / z): the rectangle grows by the lens radius times
+// the largest |1/z - 1/f| over the box, which a corner (the nearest or farthest) attains.
 void RenderSession::find_scene_rectangle() {
   const Camera& cam = m_scene.camera;
   Vec3 lo, hi;
-  if (cam.lens_radius > 0 || !m_scene.accel || !m_scene.accel->hit_bounds(lo, hi)) return;
+  if (!m_scene.accel || !m_scene.accel->hit_bounds(lo, hi)) return;
   if (!(cam.tan_half_w > 0) || !(cam.tan_half_h > 0)) return;
-  float u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf;
+  const bool lens = cam.lens_radius > 0;
+  if (lens && !(cam.focal_distance > 0 && std::isfinite(cam.focal_distance))) return;
+  float u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf, blur = 0;
   for (int c = 0; c < 8; ++c) {
     Vec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
     Vec3 v = corner - cam.position;
@@ -294,6 +299,12 @@ void RenderSession::find_scene_rectangle() {
     float w = (dot(v, cam.up) / (z * cam.tan_half_h) + 1) * 0.5f * float(m_params.height);
     if (!std::isfinite(u) || !std::isfinite(w)) return;
     u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, w), v1 = std::max(v1, w);
+    if (lens) blur = std::max(blur, cam.lens_radius * std::fabs(1 / z - 1 / cam.focal_distance));
+  }
+  if (lens) {  // blur is in sensor units (tan); pixels per unit differ along x and y
+    float bu = blur * 0.5f * float(m_params.width) / cam.tan_half_w, bv = blur * 0.5f * float(m_params.height) / cam.tan_half_h;
+    if (!std::isfinite(bu) || !std::isfinite(bv)) return;
+    u0 -= bu, u1 += bu, v0 -= bv, v1 += bv;
   }
   m_scene_u0 = u0 - 1, m_scene_u1 = u1 + 1, m_scene_v0 = v0 - 1, m_scene_v1 = v1 + 1;
   // The caustic light paths are counted on this area (it may reach beyond a cropped frame).

@@ -215,8 +215,7 @@ class RenderSession {
   int m_w, m_h;            // film size (the cell for -p)
   int m_frame_x0, m_frame_y0;  // film origin inside the full frame, top-left
   // Pixels whose every camera ray misses the scene (frame pixel coordinates, y up): outside this
-  // rectangle a sample is black and costs no ray query. Off (empty) for a thin lens or a visible
-  // environment.
+  // rectangle a sample is black and costs no ray query. Off (empty) for a visible environment.
   bool m_background_rect = false;
   float m_scene_u0 = 0, m_scene_u1 = 0, m_scene_v0 = 0, m_scene_v1 = 0;
   double m_scene_pixels = 0;  // the projected bounds' area, unclipped (0: unknown)

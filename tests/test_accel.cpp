@@ -163,10 +163,13 @@ int check_background_pixels(const RenderScene& scene, const RenderParams& p) {
     for (int fx = 0; fx < p.width; ++fx) {
       if (!session.sees_only_background(fx, fy)) continue;
       ++skipped;
-      // The pixel's corners and random points inside it.
-      for (int k = 0; k < 12; ++k) {
+      // The pixel's corners and random points inside it; for a thin lens, through the lens rim
+      // (concentric map: u on the square's edge midpoints) and random lens points.
+      const Vec2 rim[4] = {{0.f, 0.5f}, {1.f, 0.5f}, {0.5f, 0.f}, {0.5f, 1.f}};
+      for (int k = 0; k < 16; ++k) {
         float jx = k < 4 ? float(k & 1) : u(rng), jy = k < 4 ? float(k >> 1) : u(rng);
-        Ray r = scene.camera.generate_ray((fx + jx) / p.width, (fy + jy) / p.height, {0.5f, 0.5f});
+        Vec2 lens = k < 8 ? rim[k & 3] : Vec2{u(rng), u(rng)};
+        Ray r = scene.camera.generate_ray((fx + jx) / p.width, (fy + jy) / p.height, lens);
         if (ray_meets_box(r, lo, hi)) {
           ADD_FAILURE() << "pixel (" << fx << ", " << fy << ") is skipped as background but a ray through it meets the scene";
           return skipped;
@@ -203,15 +206,20 @@ TEST(Background, SkippedPixelsSeeNoGeometry) {
   check_background_pixels(*make_render_scene(cornell, p), p);
 }
 
-TEST(Background, NoShortcutForAThinLensOrAVisibleEnvironment) {
+TEST(Background, ThinLensSkipsOnlyPixelsNoLensPointSeesGeometryThrough) {
   SceneDesc d = two_shapes(Vec3(0, 0, 0));
   RenderParams p;
-  p.width = 64;
-  p.height = 48;
+  p.width = 96;
+  p.height = 72;
   p.keep_fov = true;
-  p.lens_radius = 0.05f;  // rays leave from anywhere on the lens: the pinhole projection does not apply
-  auto scene = make_render_scene(d, p);
-  RenderSession session(*scene, p);
-  for (int fy = 0; fy < p.height; ++fy)
-    for (int fx = 0; fx < p.width; ++fx) ASSERT_FALSE(session.sees_only_background(fx, fy));
+  const int pinhole = check_background_pixels(*make_render_scene(d, p), p);
+  for (float radius : {0.05f, 0.3f})
+    for (float focus : {1.0f, 4.7f, 50.0f}) {
+      p.lens_radius = radius;  // rays leave from anywhere on the lens: the rectangle grows with the blur
+      p.focal_distance = focus;
+      int skipped = check_background_pixels(*make_render_scene(d, p), p);
+      EXPECT_LE(skipped, pinhole) << radius << " " << focus;
+      if (radius > 0.1f && focus != 4.7f) EXPECT_LT(skipped, pinhole) << "a large blur must grow the rectangle";
+      if (radius < 0.1f) EXPECT_GT(skipped, pinhole / 2) << "a small lens keeps most of the shortcut, focus " << focus;
+    }
 }
