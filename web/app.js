@@ -10,7 +10,7 @@ const $ = (sel) => document.querySelector(sel);
 const FIELDS = {
   scene: 'select', max_depth: 'int', light_samples: 'int', aperture: 'num', focal_distance: 'num',
   spp: 'int', width: 'int', height: 'int', seed: 'int', time_limit: 'num', target_error: 'num', adaptive: 'bool',
-  keep_fov: 'bool',
+  keep_fov: 'bool', caustic_tracing: 'bool',
 };
 const FINAL = new Set(['done', 'failed', 'cancelled']);
 const POLL_MS = 2000;

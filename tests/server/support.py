@@ -500,6 +500,8 @@ def cli_args(spec, threads=2):
         args.append("--file-camera")
     if spec.get("keep_fov"):
         args.append("--keep-fov")
+    if not spec.get("caustic_tracing", True):
+        args.append("--no-caustic-tracing")
     return args
 
 

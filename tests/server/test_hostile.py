@@ -11,7 +11,7 @@ from support import CORNELL, TINY, RawConnection, Server, raw_request
 
 INT_FIELDS = ["max_depth", "spp", "light_samples", "width", "height", "seed", "adaptive_batch", "tile_size"]
 NUM_FIELDS = ["aperture", "focal_distance", "adaptive_tolerance", "time_limit", "target_error"]
-BOOL_FIELDS = ["adaptive", "hemisphere", "file_camera", "keep_fov"]
+BOOL_FIELDS = ["adaptive", "hemisphere", "file_camera", "keep_fov", "caustic_tracing"]
 
 
 @pytest.fixture(scope="module")
