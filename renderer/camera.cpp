@@ -150,6 +150,27 @@ Ray Camera::generate_ray(float sx, float sy, Vec2 lens_u) const {
   return r;
 }
 
+bool Camera::sensor_point(Vec3 p, Vec2 lens_u, float& sx, float& sy, Vec3& origin) const {
+  // A thin lens maps a point at depth z, seen from lens point l, to the sensor point p/z + l (1/f
+  // - 1/z) (camera space, sensor at depth 1): generate_ray aims from l at the focus point f x dc.
+  float lx = 0, ly = 0;
+  origin = position;
+  if (lens_radius > 0) {
+    if (!(focal_distance > 0)) return false;
+    Vec2 d = sample_concentric_disk(lens_u);
+    lx = lens_radius * d.x, ly = lens_radius * d.y;
+    origin = position + right * lx + up * ly;
+  }
+  Vec3 v = p - origin;
+  float z = -dot(v, back);
+  if (!(z > 0)) return false;
+  float cx = dot(v, right) / z, cy = dot(v, up) / z;
+  if (lens_radius > 0) cx += lx / focal_distance, cy += ly / focal_distance;
+  sx = (cx / tan_half_w + 1) * 0.5f;
+  sy = (cy / tan_half_h + 1) * 0.5f;
+  return std::isfinite(sx) && std::isfinite(sy);
+}
+
 void write_camera_settings(const Camera& c, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path + ": cannot write camera settings");

@@ -32,6 +32,10 @@ struct Camera {
   Ray generate_ray(float sx, float sy, Vec2 lens_u) const;
   // The pinhole ray through the same sensor point (what autofocus casts).
   Ray pinhole_ray(float sx, float sy) const;
+  // The inverse of generate_ray: the sensor point (sx, sy) whose ray from lens sample lens_u passes
+  // through world point p, and that ray's origin. False for a point not in front of the lens or a
+  // lens focused at zero. (sx, sy) may lie outside [0,1]^2.
+  bool sensor_point(Vec3 p, Vec2 lens_u, float& sx, float& sy, Vec3& origin) const;
 };
 
 // Builds the camera; throws std::runtime_error naming the settings file on a bad -c file.

@@ -55,19 +55,21 @@ Vec3 sample_cone(const Cone& c, Vec2 u) {
   return f.to_world(Vec3(std::cos(phi) * sin_t, std::sin(phi) * sin_t, cos_t));
 }
 
-// Connects the path's first non-delta vertex to the pinhole and splats what the camera sees
-// there. Light arrives along `arriving` (pointing into the surface) with flux weight `beta`.
-void splat_to_camera(const RenderScene& scene, const CausticFilm& film,
-                     const SurfaceHit& hit, const Material& m, Vec3 arriving, Vec3 beta,
+// Connects a non-delta vertex of the path to the camera (the pinhole, or the thin lens at the
+// point u_lens picks) and splats what the camera sees there. Light arrives along `arriving`
+// (pointing into the surface) with flux weight `beta`.
+void splat_to_camera(const RenderScene& scene, const CausticFilm& film, const SurfaceHit& hit,
+                     const Material& m, Vec3 arriving, Vec3 beta, Vec2 u_lens,
                      std::vector<CausticSplat>& out, uint64_t& rays) {
   const Camera& cam = scene.camera;
-  Vec3 v = hit.p - cam.position;
+  float sx, sy;
+  Vec3 eye;
+  if (!cam.sensor_point(hit.p, u_lens, sx, sy, eye)) return;
+  if (!(sx >= 0 && sx < 1 && sy >= 0 && sy < 1)) return;
+  Vec3 v = hit.p - eye;
   float dist2 = length_squared(v), dist = std::sqrt(dist2);
   float z = -dot(v, cam.back);
-  if (!(z > 0) || !(dist > 0) || dist < cam.tmin || dist > cam.tmax) return;
-  float sx = (dot(v, cam.right) / (z * cam.tan_half_w) + 1) * 0.5f;
-  float sy = (dot(v, cam.up) / (z * cam.tan_half_h) + 1) * 0.5f;
-  if (!(sx >= 0 && sx < 1 && sy >= 0 && sy < 1)) return;
+  if (!(dist > 0) || dist < cam.tmin || dist > cam.tmax) return;
   int fx = std::min(int(sx * film.frame_w), film.frame_w - 1);
   int fy_up = std::min(int(sy * film.frame_h), film.frame_h - 1);
   int x = fx - film.x0, y = (film.frame_h - 1 - fy_up) - film.y0;
@@ -88,11 +90,13 @@ void splat_to_camera(const RenderScene& scene, const CausticFilm& film,
   Vec3 f = eval_bsdf(m, frame.to_local(wo_world), wi);
   if (is_black(f)) return;
   ++rays;
-  if (scene.accel->occluded(spawn_ray_to(hit, cam.position))) return;
+  if (scene.accel->occluded(spawn_ray_to(hit, eye))) return;
 
   // Pixel value = W H / (4 tan_w tan_h) x the integral over visible area of L cos_x / (r^2 cos^3);
   // the flux estimate carries cos at the surface w.r.t. the true normal, the path tracer's
-  // L_o uses the shading cosine |wi.z| (Veach 1997, 5.3, adjoint shading normals).
+  // L_o uses the shading cosine |wi.z| (Veach 1997, 5.3, adjoint shading normals). A thin lens
+  // has the same Jacobian from each lens point (the focus plane at f maps the sensor scaled by
+  // f), and the lens point is drawn as the path tracer draws it, uniformly: no extra factor.
   float cos_cam = z / dist;
   float k = float(film.frame_w) * float(film.frame_h) / (4 * cam.tan_half_w * cam.tan_half_h);
   Vec3 value = beta * f * (std::fabs(wi.z) / cos_wi_g * cos_wo_g * k / (dist2 * cos_cam * cos_cam * cos_cam));
@@ -118,8 +122,10 @@ std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std
 }
 
 bool caustic_tracing_applies(const RenderScene& scene, const RenderParams& params) {
-  return params.caustic_tracing && !params.hemisphere && params.spp > 1 && params.max_depth >= 2 &&
-         scene.camera.lens_radius <= 0 && !scene.caustic_targets.empty() && !scene.caustic_lights.empty();
+  const Camera& cam = scene.camera;
+  const bool camera_ok = cam.lens_radius <= 0 || (cam.focal_distance > 0 && std::isfinite(cam.focal_distance));
+  return params.caustic_tracing && !params.hemisphere && params.spp > 1 && params.max_depth >= 2 && camera_ok &&
+         !scene.caustic_targets.empty() && !scene.caustic_lights.empty();
 }
 
 void trace_caustic_path(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
@@ -181,7 +187,8 @@ void trace_caustic_path(const RenderScene& scene, const RenderParams& params, co
     // one after the diffuse part ends it too (the path tracer renders both).
     if (delta ? diffuse_vertices > 0 : delta_bounces == 0) return;
     if (!delta) {
-      splat_to_camera(scene, film, hit, m, ray.d, beta, out, rays);
+      Vec2 u_lens = scene.camera.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};
+      splat_to_camera(scene, film, hit, m, ray.d, beta, u_lens, out, rays);
       ++diffuse_vertices;
     } else {
       ++delta_bounces;

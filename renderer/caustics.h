@@ -35,8 +35,9 @@ struct CausticTarget {
 std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std::vector<Material>& materials);
 
 // Whether a view of the scene with these options renders caustics by light tracing: it needs a
-// delta material, an area or mesh light, a pinhole camera, more than one sample per pixel (one
-// sample is the pixel centre, which splats cannot match), and light sampling (not -H).
+// delta material, an area or mesh light, more than one sample per pixel (one sample is the pixel
+// centre, which splats cannot match), light sampling (not -H), and a pinhole or a thin lens
+// focused at a positive distance.
 bool caustic_tracing_applies(const RenderScene& scene, const RenderParams& params);
 
 // Where on the film a point is seen: the full frame and the film window inside it (top-left).

@@ -93,6 +93,33 @@ TEST(Camera, ThinLensRaysFromOnePixelMeetOnTheFocalPlane) {
   }
 }
 
+// What light tracing splats by: the sensor point whose ray from a given lens point passes through
+// a world point, for points at every depth (in front of and behind the plane of focus).
+TEST(Camera, SensorPointInvertsGenerateRay) {
+  SceneDesc s = box_scene();
+  for (float radius : {0.0f, 0.25f}) {
+    CameraParams p;
+    p.lens_radius = radius;
+    p.focal_distance = 3.0f;
+    Camera c = make_camera(s, p);
+    Pcg32 rng(11, 3);
+    for (int k = 0; k < 200; ++k) {
+      Vec2 px = rng.next_2d(), lens = rng.next_2d();
+      Ray r = c.generate_ray(px.x, px.y, lens);
+      Vec3 point = r.o + r.d * (0.5f + 8 * rng.next_float());
+      float sx, sy;
+      Vec3 origin;
+      ASSERT_TRUE(c.sensor_point(point, lens, sx, sy, origin));
+      EXPECT_NEAR(sx, px.x, 2e-5f) << "lens radius " << radius;
+      EXPECT_NEAR(sy, px.y, 2e-5f) << "lens radius " << radius;
+      EXPECT_LT(dist(origin, r.o), 1e-5f);
+    }
+    float sx, sy;
+    Vec3 origin;
+    EXPECT_FALSE(c.sensor_point(c.position + c.back, {0.5f, 0.5f}, sx, sy, origin)) << "behind the camera";
+  }
+}
+
 TEST(Camera, ZeroLensRadiusIsExactlyThePinhole) {
   SceneDesc s = box_scene();
   CameraParams p;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 #include "collada.h"
 #include "materials.h"
@@ -76,27 +77,26 @@ SeedStats over_seeds(const SceneDesc& desc, RenderParams p, int seeds) {
   return st;
 }
 
-class CausticSplit : public ::testing::Test {
+// Pinhole (0) and thin lens (lens radius): splats through the lens map to pixels as its rays do.
+class CausticSplit : public ::testing::TestWithParam<float> {
  protected:
-  static void SetUpTestSuite() {
+  void SetUp() override {
     SceneDesc desc = load_collada(test::own_scene("cornell.dae"));  // mirror and glass spheres, area light
     RenderParams p = cornell_params();
     p.spp = 256;
-    split = new SeedStats(over_seeds(desc, p, 10));
+    p.lens_radius = GetParam();
+    p.focal_distance = 4.0f;  // the glass sphere sharp, the back wall blurred
+    split = std::make_unique<SeedStats>(over_seeds(desc, p, 10));
     p.caustic_tracing = false;
-    alone = new SeedStats(over_seeds(desc, p, 10));
+    alone = std::make_unique<SeedStats>(over_seeds(desc, p, 10));
   }
-  static void TearDownTestSuite() {
-    delete split;
-    delete alone;
-  }
-  static SeedStats* split;  // light-traced caustics
-  static SeedStats* alone;  // path tracing alone
+  std::unique_ptr<SeedStats> split;  // light-traced caustics
+  std::unique_ptr<SeedStats> alone;  // path tracing alone
 };
-SeedStats* CausticSplit::split = nullptr;
-SeedStats* CausticSplit::alone = nullptr;
+INSTANTIATE_TEST_SUITE_P(Camera, CausticSplit, ::testing::Values(0.0f, 0.12f),
+                         [](const auto& info) { return info.param > 0 ? "ThinLens" : "Pinhole"; });
 
-TEST_F(CausticSplit, SplitWithThePathTracerConvergesToThePathTracersImage) {
+TEST_P(CausticSplit, SplitWithThePathTracerConvergesToThePathTracersImageAndRemovesMostOfItsNoise) {
   // The light tracer carries a share of some block far above the noise: were its paths lost,
   // counted twice, or their splats 25% off, that block would be off by over 6 standard errors.
   std::vector<double> share = block_means(split->caustics);
@@ -110,9 +110,7 @@ TEST_F(CausticSplit, SplitWithThePathTracerConvergesToThePathTracersImage) {
   }
   EXPECT_GT(most, 25) << "the light-traced caustics must be a share of the image well above its noise";
   std::printf("largest light-traced share of a block: %.1f standard errors\n", most);
-}
 
-TEST_F(CausticSplit, LightTracingRemovesMostOfTheCausticNoise) {
   EXPECT_GT(split->light_paths, 0u);
   EXPECT_EQ(alone->light_paths, 0u);
   // True variance across seeds (the path tracer's own estimate misses rare caustic paths).
@@ -149,7 +147,9 @@ TEST(Caustics, AppliesOnlyWhereItCan) {
   q.caustic_tracing = false;
   EXPECT_FALSE(applies(q));
   q = p;
-  q.lens_radius = 0.05f;  // splats would need the lens
+  q.lens_radius = 0.05f;  // splats through the lens
+  EXPECT_TRUE(applies(q));
+  q.focal_distance = 0;  // a lens focused on itself maps nothing to the sensor
   EXPECT_FALSE(applies(q));
   q = p;
   q.spp = 1;  // one sample is the pixel centre
