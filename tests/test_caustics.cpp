@@ -77,14 +77,56 @@ SeedStats over_seeds(const SceneDesc& desc, RenderParams p, int seeds) {
   return st;
 }
 
-// Pinhole (0) and thin lens (lens radius): splats through the lens map to pixels as its rays do.
-class CausticSplit : public ::testing::TestWithParam<float> {
+// The Cornell box with its area light turned into an emissive mesh (a mesh light: the light tracer
+// samples its triangles) and the white surfaces into rough metal (splats evaluate a microfacet BRDF).
+SceneDesc mesh_light_metal_cornell() {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  std::vector<LightDesc> kept;
+  for (const LightDesc& l : desc.lights) {
+    if (l.type != LightType::area) {
+      kept.push_back(l);
+      continue;
+    }
+    Material em;
+    em.name = l.name + " (mesh)";
+    em.type = MaterialType::emission;
+    em.radiance = l.color;
+    desc.materials.push_back(em);
+    MeshDesc m;
+    m.name = l.name;
+    Vec3 hx = l.dim_x * 0.5f, hy = l.dim_y * 0.5f;
+    m.positions = {l.position - hx - hy, l.position + hx - hy, l.position + hx + hy, l.position - hx + hy};
+    // Emitters emit on their winding's side: wind the quad to face the light's direction.
+    if (dot(cross(l.dim_x, l.dim_y), l.direction) > 0) m.indices = {0, 1, 2, 0, 2, 3};
+    else m.indices = {0, 2, 1, 0, 3, 2};
+    m.tri_material = {int(desc.materials.size()) - 1, int(desc.materials.size()) - 1};
+    desc.meshes.push_back(m);
+  }
+  desc.lights = kept;
+  for (Material& m : desc.materials)
+    if (m.name == "white") {
+      m.type = MaterialType::microfacet;
+      m.alpha = 0.3f;
+      m.eta = Vec3(1.66f, 0.88f, 0.52f);  // aluminium
+      m.k = Vec3(9.2f, 6.3f, 4.8f);
+    }
+  return desc;
+}
+
+struct SplitCase {
+  const char* name;
+  float lens_radius;  // 0: pinhole; else splats through the lens map to pixels as its rays do
+  bool mesh_light_metal;
+};
+
+class CausticSplit : public ::testing::TestWithParam<SplitCase> {
  protected:
   void SetUp() override {
-    SceneDesc desc = load_collada(test::own_scene("cornell.dae"));  // mirror and glass spheres, area light
+    SceneDesc desc = GetParam().mesh_light_metal ? mesh_light_metal_cornell()
+                                                 : load_collada(test::own_scene("cornell.dae"));  // mirror, glass, area light
     RenderParams p = cornell_params();
     p.spp = 256;
-    p.lens_radius = GetParam();
+    p.lens_radius = GetParam().lens_radius;
     p.focal_distance = 4.0f;  // the glass sphere sharp, the back wall blurred
     split = std::make_unique<SeedStats>(over_seeds(desc, p, 10));
     p.caustic_tracing = false;
@@ -93,8 +135,10 @@ class CausticSplit : public ::testing::TestWithParam<float> {
   std::unique_ptr<SeedStats> split;  // light-traced caustics
   std::unique_ptr<SeedStats> alone;  // path tracing alone
 };
-INSTANTIATE_TEST_SUITE_P(Camera, CausticSplit, ::testing::Values(0.0f, 0.12f),
-                         [](const auto& info) { return info.param > 0 ? "ThinLens" : "Pinhole"; });
+INSTANTIATE_TEST_SUITE_P(Cases, CausticSplit,
+                         ::testing::Values(SplitCase{"Pinhole", 0, false}, SplitCase{"ThinLens", 0.12f, false},
+                                           SplitCase{"MeshLightRoughMetal", 0, true}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 TEST_P(CausticSplit, SplitWithThePathTracerConvergesToThePathTracersImageAndRemovesMostOfItsNoise) {
   // The light tracer carries a share of some block far above the noise: were its paths lost,
@@ -160,6 +204,11 @@ TEST(Caustics, AppliesOnlyWhereItCan) {
   q = p;
   q.max_depth = 1;  // no room for a delta bounce
   EXPECT_FALSE(applies(q));
+  // An emissive mesh is a light the light tracer samples too.
+  auto mesh_lit = make_render_scene(mesh_light_metal_cornell(), p);
+  ASSERT_TRUE(mesh_lit->features.caustic_tracing);
+  ASSERT_EQ(mesh_lit->caustic_lights.size(), 1u);
+  EXPECT_EQ(mesh_lit->lights[mesh_lit->caustic_lights[0]].kind, LightKind::mesh);
   // Without delta materials there is nothing to aim at.
   SceneDesc diffuse = desc;
   for (Material& m : diffuse.materials)
