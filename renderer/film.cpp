@@ -8,13 +8,15 @@ namespace pt {
 
 namespace {
 
-constexpr char kMagic[8] = {'P', 'T', 'F', 'I', 'L', 'M', '1', 0};
+constexpr char kMagic[8] = {'P', 'T', 'F', 'I', 'L', 'M', '2', 0};
 
 struct Header {
   char magic[8];
   uint32_t width, height, first, count;
   uint64_t rays, nonfinite;
   double seconds;
+  uint64_t light_paths;
+  uint32_t has_caustics, unused;  // caustic sums follow the sample counts
 };
 
 template <class T>
@@ -44,10 +46,14 @@ std::string FilmPass::encode() const {
   h.rays = rays;
   h.nonfinite = nonfinite;
   h.seconds = seconds;
+  h.light_paths = light_paths;
+  h.has_caustics = caustic_sum.empty() ? 0 : 1;
+  h.unused = 0;
   std::string out(reinterpret_cast<const char*>(&h), sizeof h);
   append(out, sum);
   append(out, lum2);
   append(out, samples);
+  append(out, caustic_sum);
   return out;
 }
 
@@ -55,12 +61,13 @@ FilmPass FilmPass::decode(const std::string& bytes, int expect_width, int expect
   Header h;
   if (bytes.size() < sizeof h) throw std::runtime_error("film pass: " + std::to_string(bytes.size()) + " bytes is too short");
   std::memcpy(&h, bytes.data(), sizeof h);
-  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) throw std::runtime_error("film pass: not a PTFILM1 buffer");
+  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) throw std::runtime_error("film pass: not a PTFILM2 buffer");
+  if (h.has_caustics > 1) throw std::runtime_error("film pass: bad caustics flag");
   if (int(h.width) != expect_width || int(h.height) != expect_height)
     throw std::runtime_error("film pass: " + std::to_string(h.width) + "x" + std::to_string(h.height) + " film, expected " +
                              std::to_string(expect_width) + "x" + std::to_string(expect_height));
   size_t n = size_t(h.width) * h.height;
-  if (bytes.size() != sizeof h + n * (sizeof(Vec3) + sizeof(float) + sizeof(uint32_t)))
+  if (bytes.size() != sizeof h + n * (sizeof(Vec3) + sizeof(float) + sizeof(uint32_t) + h.has_caustics * sizeof(Vec3)))
     throw std::runtime_error("film pass: " + std::to_string(bytes.size()) + " bytes does not match a " +
                              std::to_string(h.width) + "x" + std::to_string(h.height) + " film");
   FilmPass p;
@@ -71,12 +78,15 @@ FilmPass FilmPass::decode(const std::string& bytes, int expect_width, int expect
   p.rays = h.rays;
   p.nonfinite = h.nonfinite;
   p.seconds = h.seconds;
+  p.light_paths = h.light_paths;
   size_t at = sizeof h;
   extract(bytes, at, p.sum, n);
   extract(bytes, at, p.lum2, n);
   extract(bytes, at, p.samples, n);
+  if (h.has_caustics) extract(bytes, at, p.caustic_sum, n);
   for (size_t i = 0; i < n; ++i)
-    if (p.samples[i] > p.count || !is_finite(p.sum[i]) || !std::isfinite(p.lum2[i]))
+    if (p.samples[i] > p.count || !is_finite(p.sum[i]) || !std::isfinite(p.lum2[i]) ||
+        (h.has_caustics && !is_finite(p.caustic_sum[i])))
       throw std::runtime_error("film pass: pixel " + std::to_string(i) + " holds impossible values");
   return p;
 }
@@ -85,7 +95,6 @@ FilmPass render_film_pass(const RenderScene& scene, const RenderParams& params, 
                           const std::vector<uint8_t>& skip, const std::atomic<bool>* cancel, bool* complete) {
   RenderParams p = params;
   p.adaptive = false;  // convergence is judged on the merged statistics, not per pass
-  p.caustic_tracing = false;  // light-traced splats do not split by sample range: paths carry caustics
   RenderSession session(scene, p);
   session.set_sample_range(first, skip);
   bool ok = session.render_pass(int(count), cancel);
@@ -98,7 +107,9 @@ FilmPass render_film_pass(const RenderScene& scene, const RenderParams& params, 
   out.sum = session.pixel_sums();
   out.lum2.assign(session.pixel_lum2_sums().begin(), session.pixel_lum2_sums().end());
   out.samples = session.pixel_counts();
+  out.caustic_sum = session.caustic_sums();
   SessionStats st = session.stats();
+  out.light_paths = st.light_paths;
   out.rays = st.rays;
   out.nonfinite = st.nonfinite;
   out.seconds = st.seconds;
@@ -118,12 +129,34 @@ FilmAccumulator::FilmAccumulator(const RenderParams& params, int width, int heig
   m_remaining = n;
 }
 
+Vec3 FilmAccumulator::pixel_mean(size_t i) const {
+  Vec3 v = m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f);
+  if (m_lt_paths > 0) v += m_lt_sum[i] / float(m_lt_paths);
+  return v;
+}
+
 void FilmAccumulator::merge(const FilmPass& pass) {
   if (pass.width != m_w || pass.height != m_h) throw std::runtime_error("film pass of the wrong size");
   uint64_t pass_samples = 0;
   for (uint32_t c : pass.samples) pass_samples += c;
   const bool to_half = m_half_samples <= m_other_samples;
   (to_half ? m_half_samples : m_other_samples) += pass_samples;
+  if (!pass.caustic_sum.empty() && pass.light_paths > 0) {
+    if (pass.caustic_sum.size() != m_sum.size()) throw std::runtime_error("film pass: caustics of the wrong size");
+    if (m_lt_sum.empty()) {
+      m_lt_sum.assign(m_sum.size(), Vec3(0.0f));
+      m_lt_s1.assign(m_sum.size(), 0);
+      m_lt_half_s1.assign(m_sum.size(), 0);
+    }
+    for (size_t i = 0; i < m_lt_sum.size(); ++i) {
+      m_lt_sum[i] += pass.caustic_sum[i];
+      double l = luminance(pass.caustic_sum[i]);
+      m_lt_s1[i] += l;
+      if (to_half) m_lt_half_s1[i] += l;
+    }
+    m_lt_paths += pass.light_paths;
+    if (to_half) m_lt_half_paths += pass.light_paths;
+  }
   const int batch = std::max(1, m_params.adaptive_batch);
   for (size_t i = 0; i < m_sum.size(); ++i) {
     uint32_t c = pass.samples[i];
@@ -160,7 +193,8 @@ double FilmAccumulator::progress() const {
 
 double FilmAccumulator::error_estimate() const {
   // As the session's, with the two halves made of whole passes.
-  return halves_error_estimate(m_count, m_half_n, m_s1, m_half_s1);
+  return halves_error_estimate(m_count, m_half_n, m_s1, m_half_s1,
+                               {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths});
 }
 
 ImageRGB FilmAccumulator::image() const {
@@ -168,7 +202,7 @@ ImageRGB FilmAccumulator::image() const {
   img.width = m_w;
   img.height = m_h;
   img.pixels.resize(m_sum.size());
-  for (size_t i = 0; i < m_sum.size(); ++i) img.pixels[i] = m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f);
+  for (size_t i = 0; i < m_sum.size(); ++i) img.pixels[i] = pixel_mean(i);
   return img;
 }
 
@@ -176,8 +210,7 @@ void FilmAccumulator::read_tile(const Tile& t, std::vector<Vec3>& out) const {
   out.clear();
   for (int y = t.y0; y < t.y1; ++y)
     for (int x = t.x0; x < t.x1; ++x) {
-      size_t i = size_t(y) * m_w + x;
-      out.push_back(m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f));
+      out.push_back(pixel_mean(size_t(y) * m_w + x));
     }
 }
 

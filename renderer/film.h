@@ -20,6 +20,10 @@ struct FilmPass {
   std::vector<Vec3> sum;           // radiance sums per pixel
   std::vector<float> lum2;         // luminance-squared sums (adaptive sampling's variance)
   std::vector<uint32_t> samples;   // samples taken per pixel (0 for skipped pixels)
+  // Light-traced caustics (caustics.h): splat sums per pixel over `light_paths` paths, the pass's
+  // share of them; empty when the job renders caustics by path tracing alone.
+  std::vector<Vec3> caustic_sum;
+  uint64_t light_paths = 0;
   uint64_t rays = 0, nonfinite = 0;
   double seconds = 0;
 
@@ -53,6 +57,7 @@ class FilmAccumulator {
   uint64_t samples() const { return m_samples; }
   uint64_t rays() const { return m_rays; }
   uint64_t nonfinite() const { return m_nonfinite; }
+  uint64_t light_paths() const { return m_lt_paths; }  // caustic light paths merged
   ImageRGB image() const;
   void read_tile(const Tile& t, std::vector<Vec3>& out) const;
 
@@ -69,6 +74,11 @@ class FilmAccumulator {
   uint64_t m_half_samples = 0, m_other_samples = 0;
   std::vector<uint8_t> m_done;
   size_t m_remaining;
+  // Caustic splat sums and their luminance, split into the same halves as the camera samples.
+  std::vector<Vec3> m_lt_sum;
+  std::vector<double> m_lt_s1, m_lt_half_s1;
+  uint64_t m_lt_paths = 0, m_lt_half_paths = 0;
+  Vec3 pixel_mean(size_t i) const;
   uint64_t m_samples = 0, m_rays = 0, m_nonfinite = 0;
 };
 

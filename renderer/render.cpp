@@ -381,13 +381,18 @@ constexpr double kLightPathsPerScenePixel = 0.15, kMaxLightPathsPerSample = 1.0;
 
 // The pass's share of caustic light paths, before its tiles so that tiles published during the
 // pass include them. Splats are merged in path order: images do not depend on the thread count.
-void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) {
-  // Counted on the full frame: a cell (-p) traces the frame's paths and keeps its own splats, so
-  // it renders exactly its window of the full frame.
+// The light paths that go with camera samples [0, samples): counted on the full frame, so a cell
+// (-p) traces the frame's paths and keeps its own splats (it renders exactly its window of the
+// full frame), and a share of sample indices (set_sample_range) its share of light paths.
+uint64_t RenderSession::light_paths_for(uint64_t samples) const {
   const double frame = double(m_params.width) * m_params.height;
   const double scene = m_scene_pixels > 0 ? m_scene_pixels : frame;
   const double per_sample = std::min(kMaxLightPathsPerSample * frame, kLightPathsPerScenePixel * scene);
-  uint64_t want = uint64_t(std::ceil(per_sample * target));
+  return uint64_t(std::ceil(per_sample * double(samples)));
+}
+
+void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) {
+  uint64_t want = light_paths_for(uint64_t(m_first_sample) + uint64_t(target));
   if (want <= m_lt_issued) return;
   if (m_lt_paths > 0 && m_lt_paths >= 2 * m_lt_half_paths) {  // the error estimate's halves
     m_lt_half_s1 = m_lt_s1;
@@ -521,6 +526,7 @@ Vec3 RenderSession::pixel_mean(size_t i) const {
 
 void RenderSession::set_sample_range(uint32_t first, const std::vector<uint8_t>& skip) {
   m_first_sample = first;
+  if (m_params.caustics_light_traced) m_lt_issued = light_paths_for(first);
   for (size_t i = 0; i < skip.size() && i < m_done.size(); ++i) m_done[i] |= skip[i];
 }
 

@@ -191,12 +191,16 @@ class RenderSession {
   void read_tile_rate(const Tile& t, std::vector<Vec3>& out) const;
 
   // For one share of a distributed render: sample indices start at `first` (so disjoint ranges
-  // merge into the single-machine image) and pixels whose `skip` byte is set are left out.
+  // merge into the single-machine image; the caustic light paths follow the same share) and pixels
+  // whose `skip` byte is set are left out. Call before the first pass.
   void set_sample_range(uint32_t first, const std::vector<uint8_t>& skip);
   // Per-pixel sums of what was rendered: radiance, luminance squared, and sample counts.
   const std::vector<Vec3>& pixel_sums() const { return m_sum; }
   const std::vector<double>& pixel_lum2_sums() const { return m_s2; }
   const std::vector<uint32_t>& pixel_counts() const { return m_count; }
+  // Light-traced caustic splat sums per pixel (empty when caustics are path traced) over
+  // stats().light_paths light paths.
+  const std::vector<Vec3>& caustic_sums() const { return m_lt_sum; }
   // True when every camera ray of frame pixel (fx, fy_up) (y up, as the course counts rows) misses
   // the scene, so that its samples are black without a ray query (see find_scene_rectangle).
   bool sees_only_background(int fx, int fy_up) const {
@@ -206,6 +210,7 @@ class RenderSession {
  private:
   void find_scene_rectangle();
   void trace_caustics(int target_spp, const std::atomic<bool>* cancel);
+  uint64_t light_paths_for(uint64_t samples) const;
   Vec3 pixel_mean(size_t i) const;
   void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
                    uint64_t& samples, uint64_t& nonfinite);

@@ -40,7 +40,9 @@ constexpr double kPassSeconds = 2.0, kPassBytesPerSecond = 4e6;
 
 class PassPlan {
  public:
-  PassPlan(int spp, size_t pixels) : m_spp(uint32_t(spp)), m_pixels(pixels) {}
+  // A pass carries 20 bytes a pixel (FilmPass), 32 with light-traced caustics.
+  PassPlan(int spp, size_t pixels, double bytes_per_pixel)
+      : m_spp(uint32_t(spp)), m_pixels(pixels), m_pixel_bytes(bytes_per_pixel) {}
 
   bool exhausted() const { return m_next_first >= m_spp; }
   size_t issued() const { return m_ranges.size(); }
@@ -59,7 +61,7 @@ class PassPlan {
     if (first > 0) {
       uint32_t want = first, floor = 1;  // ramp: 1, 1, 2, 4, ... until a pass has been measured
       if (m_rate > 0) {
-        double seconds = std::max(kPassSeconds, 20.0 * double(m_pixels) / kPassBytesPerSecond);
+        double seconds = std::max(kPassSeconds, m_pixel_bytes * double(m_pixels) / kPassBytesPerSecond);
         uint32_t timed = uint32_t(std::min(1024.0, std::max(1.0, m_rate * seconds / double(std::max<size_t>(active, 1)))));
         want = std::min(timed, 2 * first);  // grow at most twofold a pass
         floor = std::max(1u, timed / 4);    // the last passes shrink, but not to a trail of tiny ones
@@ -78,6 +80,7 @@ class PassPlan {
  private:
   uint32_t m_spp, m_next_first = 0;
   size_t m_pixels;
+  double m_pixel_bytes;
   double m_rate = 0;  // pixel-samples per second of one worker, smoothed
   std::vector<std::pair<uint32_t, uint32_t>> m_ranges;
 };
@@ -135,7 +138,7 @@ class RedisBackend : public RenderBackend {
       }
     } cleanup{redis, job_key, results};
 
-    PassPlan plan(p.spp, pixels);
+    PassPlan plan(p.spp, pixels, p.caustic_tracing ? 32.0 : 20.0);  // the scene decides; plan for the larger
     pt::FilmAccumulator film(p, w, h);
     std::vector<pt::Tile> tiles;
     for (int y = 0; y < h; y += p.tile_size)

@@ -24,7 +24,6 @@ struct Fixture {
     params.threads = 2;
     params.seed = 11;
     params.tile_size = 16;
-    params.caustic_tracing = false;  // film passes render caustics by path tracing alone
     SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
     scene = make_render_scene(desc, params);
   }
@@ -49,6 +48,9 @@ TEST(Film, DisjointPassesMergeIntoTheSessionImage) {
     for (int c = 0; c < 3; ++c)
       worst = std::max(worst, double(std::abs(merged.pixels[i][c] - whole.pixels[i][c])) / (whole.pixels[i][c] + 1e-3));
   EXPECT_LT(worst, 1e-4) << "merged passes must hold the same samples as the session";
+  // Light-traced caustics split by the same shares: the same light paths, none twice.
+  EXPECT_GT(session.stats().light_paths, 0u);
+  EXPECT_EQ(film.light_paths(), session.stats().light_paths);
   // Different samples make a visibly different image: the check above can fail.
   FilmAccumulator other(f.params, 48, 36);
   other.merge(render_film_pass(*f.scene, f.params, 16, 16, {}, nullptr));
@@ -67,11 +69,20 @@ TEST(Film, EncodingRoundTripsAndRefusesDamage) {
   EXPECT_EQ(q.first, 0u);
   EXPECT_EQ(q.count, 4u);
   EXPECT_EQ(q.rays, p.rays);
+  EXPECT_GT(p.light_paths, 0u);
+  EXPECT_EQ(q.light_paths, p.light_paths);
   ASSERT_EQ(q.sum.size(), p.sum.size());
+  ASSERT_EQ(q.caustic_sum.size(), p.caustic_sum.size());
   for (size_t i = 0; i < p.sum.size(); ++i) {
     EXPECT_EQ(q.sum[i][1], p.sum[i][1]);
     EXPECT_EQ(q.samples[i], p.samples[i]);
+    EXPECT_EQ(q.caustic_sum[i][0], p.caustic_sum[i][0]);
   }
+  FilmPass plain = p;  // a job with path-traced caustics sends none
+  plain.caustic_sum.clear();
+  plain.light_paths = 0;
+  EXPECT_TRUE(FilmPass::decode(plain.encode(), 48, 36).caustic_sum.empty());
+  EXPECT_EQ(plain.encode().size() + 48 * 36 * sizeof(Vec3), bytes.size());
   EXPECT_THROW(FilmPass::decode(bytes, 36, 48), std::runtime_error);                       // another film
   EXPECT_THROW(FilmPass::decode(bytes.substr(0, bytes.size() - 1), 48, 36), std::runtime_error);  // truncated
   EXPECT_THROW(FilmPass::decode(bytes.substr(0, 10), 48, 36), std::runtime_error);
@@ -81,6 +92,9 @@ TEST(Film, EncodingRoundTripsAndRefusesDamage) {
   FilmPass nan = p;
   nan.sum[5] = Vec3(NAN, 0, 0);
   EXPECT_THROW(FilmPass::decode(nan.encode(), 48, 36), std::runtime_error);  // impossible values
+  FilmPass nan_splat = p;
+  nan_splat.caustic_sum[7] = Vec3(0, INFINITY, 0);
+  EXPECT_THROW(FilmPass::decode(nan_splat.encode(), 48, 36), std::runtime_error);
   FilmPass many = p;
   many.samples[3] = 99;
   EXPECT_THROW(FilmPass::decode(many.encode(), 48, 36), std::runtime_error);

@@ -18,10 +18,8 @@ import pytest
 from support import SOURCE_DIR, read_exr
 
 RENDER_WORKER = Path(os.environ.get("PT_RENDER_WORKER", SOURCE_DIR / "build/render-worker"))
-# Workers render caustics by path tracing alone (film passes split by sample range, splats do not):
-# the embedded render they are compared with does the same.
-JOB = {"scene": "cornell", "width": 160, "height": 120, "spp": 256, "max_depth": 4, "adaptive": False, "seed": 7,
-       "caustic_tracing": False}
+# cornell has mirror and glass spheres and an area light: passes carry light-traced caustics too.
+JOB = {"scene": "cornell", "width": 160, "height": 120, "spp": 256, "max_depth": 4, "adaptive": False, "seed": 7}
 
 
 def free_port():
