@@ -137,7 +137,7 @@ TEST(Cli, HelpDocumentsEveryFlag) {
   RunResult r = run("--help");
   EXPECT_EQ(r.status, 0);
   for (const char* f : {"-s ", "-l ", "-t ", "-m ", "-e ", "-b ", "-d ", "-f ", "-r ", "-c ", "-a ", "-p ", "-H ",
-                        "-h", "--file-camera", "--seed", "--no-adaptive"})
+                        "-h", "--file-camera", "--seed", "--no-adaptive", "--no-caustic-tracing"})
     EXPECT_NE(r.output.find(f), std::string::npos) << f;
 }
 
@@ -193,8 +193,31 @@ TEST(Cli, DescribePrintsTheFeatureSetAndMemory) {
   EXPECT_NE(r.output.find("lights:           area"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("specialised: delta no-microfacet no-infinite-lights"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("bytes per primitive"), std::string::npos) << r.output;
+  // The defaults (-s 1 -m 1): one sample is the pixel centre, and one bounce has no caustic.
+  EXPECT_NE(r.output.find("caustics:         path traced only"), std::string::npos) << r.output;
+  r = run("-s 16 -m 5 --describe " + test::own_scene("cornell.dae"));
+  EXPECT_NE(r.output.find("caustics:         light traced"), std::string::npos) << r.output;
   r = run("--describe --generic " + test::own_scene("cornell.dae"));
   EXPECT_NE(r.output.find("path loop:        generic"), std::string::npos) << r.output;
+  r = run("-s 16 -m 5 --describe --no-caustic-tracing " + test::own_scene("cornell.dae"));
+  EXPECT_NE(r.output.find("caustics:         path traced only"), std::string::npos) << r.output;
+  r = run("-s 16 -m 5 --describe " + test::own_scene("dof.dae"));  // no mirror or glass: nothing to trace
+  EXPECT_NE(r.output.find("caustics:         path traced only"), std::string::npos) << r.output;
+}
+
+TEST(Cli, CausticLightPathsAreRecordedInTheExrHeader) {
+  std::string dir = test::temp_dir(), scene = test::own_scene("cornell.dae");
+  for (bool traced : {true, false}) {
+    std::string out = dir + (traced ? "/lt.exr" : "/pt.exr");
+    RunResult r = run(std::string("-s 4 -m 3 -r 64 48 --keep-fov --quiet ") + (traced ? "" : "--no-caustic-tracing ") +
+                      "-f " + out + " " + scene);
+    ASSERT_EQ(r.status, 0) << r.output;
+    auto in = OIIO::ImageInput::open(out);
+    ASSERT_TRUE(in);
+    std::string paths = in->spec().get_string_attribute("pathtracer:caustic_light_paths");
+    if (traced) EXPECT_GT(std::stoll(paths), 0) << paths;
+    else EXPECT_EQ(paths, "0");
+  }
 }
 
 TEST(Cli, ErrorLogTargetErrorAndReference) {
