@@ -118,6 +118,14 @@ std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std
         for (int k = 0; k < 3; ++k) b.expand(mesh.positions[mesh.indices[3 * t + k]]);
     if (!b.empty()) out.push_back(padded(b.center(), 0.5f * length(b.diagonal())));
   }
+  if (out.size() > kMaxCausticTargets) {  // one sphere around them all: coarser aim, still every path
+    Bounds3 b;
+    for (const CausticTarget& t : out) {
+      b.expand(t.center - Vec3(t.radius, t.radius, t.radius));
+      b.expand(t.center + Vec3(t.radius, t.radius, t.radius));
+    }
+    out.assign(1, padded(b.center(), 0.5f * length(b.diagonal())));
+  }
   return out;
 }
 
@@ -151,9 +159,8 @@ void trace_caustic_path(const RenderScene& scene, const RenderParams& params, co
 
   // A direction into the cone of one target, chosen in proportion to the cones' solid angles: the
   // pdf is the number of cones holding the direction over their total solid angle.
-  constexpr size_t kMaxTargets = 64;
-  Cone cones[kMaxTargets];
-  size_t nt = std::min(scene.caustic_targets.size(), kMaxTargets);
+  Cone cones[kMaxCausticTargets];
+  size_t nt = scene.caustic_targets.size();
   float total = 0;
   for (size_t k = 0; k < nt; ++k) total += (cones[k] = cone_towards(x0, scene.caustic_targets[k])).solid_angle;
   Vec2 u_dir = rng.next_2d();

@@ -31,7 +31,9 @@ struct CausticTarget {
   float radius = 0;
 };
 
-// One bounding sphere per sphere with a delta material and one per mesh for its delta triangles.
+// One bounding sphere per sphere with a delta material and one per mesh for its delta triangles;
+// past kMaxCausticTargets of them, one sphere around them all (a light path weighs every cone).
+constexpr size_t kMaxCausticTargets = 64;
 std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std::vector<Material>& materials);
 
 // Whether a view of the scene with these options renders caustics by light tracing: it needs a

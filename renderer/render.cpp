@@ -398,34 +398,41 @@ void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) 
     m_lt_half_s1 = m_lt_s1;
     m_lt_half_paths = m_lt_paths;
   }
-  constexpr uint64_t kChunk = 1024;
+  // Chunks of paths run on the threads in waves; each wave's splats are merged in path order before
+  // the next, which bounds the memory they take whatever the pass's size.
+  constexpr uint64_t kChunk = 1024, kWave = 64;
   const uint64_t first = m_lt_issued, count = want - first;
   m_lt_issued = want;  // paths of a cancelled chunk are skipped, not retried: they stay independent
-  const size_t chunks = size_t((count + kChunk - 1) / kChunk);
-  std::vector<std::vector<CausticSplat>> splats(chunks);
-  std::vector<uint8_t> finished(chunks, 0);
-  std::atomic<size_t> next{0};
-  auto worker = [&]() {
-    uint64_t rays = 0;
-    for (size_t c; (c = next.fetch_add(1)) < chunks && !stop_requested(cancel);) {
-      uint64_t b = first + c * kChunk, e = std::min(first + count, b + kChunk);
-      for (uint64_t i = b; i < e; ++i) trace_caustic_path(m_scene, m_params, m_caustic_film, i, splats[c], rays);
-      finished[c] = 1;
+  const uint64_t chunks = (count + kChunk - 1) / kChunk;
+  std::vector<std::vector<CausticSplat>> splats(size_t(std::min(chunks, kWave)));
+  std::vector<uint8_t> finished(splats.size());
+  for (uint64_t wave = 0; wave < chunks && !stop_requested(cancel); wave += kWave) {
+    const size_t in_wave = size_t(std::min(kWave, chunks - wave));
+    for (auto& s : splats) s.clear();
+    std::fill(finished.begin(), finished.end(), 0);
+    std::atomic<size_t> next{0};
+    auto worker = [&]() {
+      uint64_t rays = 0;
+      for (size_t c; (c = next.fetch_add(1)) < in_wave && !stop_requested(cancel);) {
+        uint64_t b = first + (wave + c) * kChunk, e = std::min(first + count, b + kChunk);
+        for (uint64_t i = b; i < e; ++i) trace_caustic_path(m_scene, m_params, m_caustic_film, i, splats[c], rays);
+        finished[c] = 1;
+      }
+      m_rays += rays;
+    };
+    int nthreads = std::max(1, std::min<int>(m_params.threads, int(in_wave)));
+    std::vector<std::thread> pool;
+    for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    for (size_t c = 0; c < in_wave; ++c) {
+      if (!finished[c]) continue;
+      for (const CausticSplat& s : splats[c]) {
+        m_lt_sum[s.pixel] += s.value;
+        m_lt_s1[s.pixel] += luminance(s.value);
+      }
+      m_lt_paths += std::min(kChunk, count - (wave + c) * kChunk);
     }
-    m_rays += rays;
-  };
-  int nthreads = std::max(1, std::min<int>(m_params.threads, int(chunks)));
-  std::vector<std::thread> pool;
-  for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  for (size_t c = 0; c < chunks; ++c) {
-    if (!finished[c]) continue;
-    for (const CausticSplat& s : splats[c]) {
-      m_lt_sum[s.pixel] += s.value;
-      m_lt_s1[s.pixel] += luminance(s.value);
-    }
-    m_lt_paths += std::min(kChunk, count - c * kChunk);
   }
 }
 

@@ -216,5 +216,18 @@ TEST(Caustics, AppliesOnlyWhereItCan) {
   EXPECT_FALSE(make_render_scene(diffuse, p)->features.caustic_tracing);
 }
 
+TEST(Caustics, ManyDeltaObjectsShareOneTargetThatHoldsThemAll) {
+  SceneDesc desc;
+  Material glass;
+  glass.type = MaterialType::glass;
+  desc.materials = {glass};
+  for (int i = 0; i < 100; ++i) desc.spheres.push_back({"s", Vec3(float(i % 10), 0.5f, float(i / 10)), 0.25f, 0});
+  std::vector<CausticTarget> t = find_caustic_targets(desc, desc.materials);
+  ASSERT_EQ(t.size(), 1u) << "light paths weigh every cone: past the limit one sphere holds them all";
+  for (const SphereDesc& s : desc.spheres) EXPECT_LE(length(s.center - t[0].center) + s.radius, t[0].radius);
+  desc.spheres.resize(3);
+  EXPECT_EQ(find_caustic_targets(desc, desc.materials).size(), 3u);
+}
+
 }  // namespace
 }  // namespace pt
