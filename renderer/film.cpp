@@ -193,7 +193,7 @@ double FilmAccumulator::progress() const {
 
 double FilmAccumulator::error_estimate() const {
   // As the session's, with the two halves made of whole passes.
-  return halves_error_estimate(m_count, m_half_n, m_s1, m_half_s1,
+  return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
                                {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths});
 }
 

@@ -134,7 +134,8 @@ inline bool confidence_reached(double s1, double s2, uint32_t n, double toleranc
 }
 
 // The error estimate both the session and the scale-out's merged film report: from per-pixel
-// sample counts n, luminance sums s1, and the count and sum of a first part of each pixel's samples.
+// sample counts n, luminance sums s1, and the count and sum of a first part of each pixel's samples,
+// on a film `width` pixels wide (row-major).
 // Light-traced splats (caustics.h) add their own variance, estimated the same way from the
 // per-pixel splat luminance sums of n light paths and of the first half_n of them.
 struct SplatStats {
@@ -142,7 +143,7 @@ struct SplatStats {
   const std::vector<double>* half_s1 = nullptr;
   uint64_t n = 0, half_n = 0;
 };
-double halves_error_estimate(const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
+double halves_error_estimate(int width, const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
                              const std::vector<double>& s1, const std::vector<double>& half_s1,
                              const SplatStats& splats = {});
 
