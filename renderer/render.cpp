@@ -619,7 +619,8 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
       }
     }
     double mu = mean[i];
-    if (h > 0 && size_t(w) * size_t(h) == n_pixels) {
+    // A firefly: from one half only (a bright edge is in both), and far above its neighbours.
+    if (std::max(a, b) > 3 * std::min(a, b) && h > 0 && size_t(w) * size_t(h) == n_pixels) {
       int x = int(i % size_t(w)), y = int(i / size_t(w));
       double v[9];
       int k = 0;
@@ -627,8 +628,7 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
         for (int dx = -1; dx <= 1; ++dx)
           v[k++] = mean[size_t(std::clamp(y + dy, 0, h - 1)) * size_t(w) + size_t(std::clamp(x + dx, 0, w - 1))];
       std::nth_element(v, v + 4, v + 9);
-      // A firefly: far above its neighbours, and from one half only (a bright edge is in both).
-      if (mu > 3 * v[4] && std::max(a, b) > 3 * std::min(a, b)) mu = std::max(v[4], std::min(a, b));
+      if (mu > 3 * v[4]) mu = std::max(v[4], std::min(a, b));
     }
     sum += var_mean / (mu * mu + kRelMseEpsilon);
     ++used;

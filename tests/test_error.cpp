@@ -74,3 +74,32 @@ TEST(ErrorEstimateMc, FallsLikeOneOverSamplesAndIsFiniteOnBlackImages) {
   EXPECT_TRUE(std::isfinite(d.error_estimate()));
   EXPECT_LT(d.error_estimate(), 1e-3);
 }
+
+// The estimate's denominator: a firefly (a pixel far above its neighbours, from one half of its
+// samples) divides by its neighbourhood, not by its inflated mean; a bright edge (in both halves)
+// keeps its own mean.
+TEST(ErrorEstimateDenominator, FireflyUsesItsNeighbourhoodBrightEdgeKeepsItsOwnMean) {
+  const int w = 5, h = 5, n = 64, p = 32;
+  auto estimate_with_centre = [&](double first_half_mean, double second_half_mean) {
+    std::vector<uint32_t> count(w * h, n), half_n(w * h, p);
+    std::vector<double> s1(w * h), half(w * h);
+    for (int i = 0; i < w * h; ++i) {  // neighbours: mean 0.5, halves 0.49 and 0.51
+      half[i] = 0.49 * p;
+      s1[i] = half[i] + 0.51 * (n - p);
+    }
+    half[12] = first_half_mean * p;
+    s1[12] = half[12] + second_half_mean * (n - p);
+    return halves_error_estimate(w, count, half_n, s1, half);
+  };
+  double quiet = estimate_with_centre(0.49, 0.51);
+  // Firefly: one sample of 620 in the second half lifts that half's mean to about 20.
+  double firefly = estimate_with_centre(0.5, 20.0);
+  double var_mean = (19.5 * 19.5) * p * (n - p) / double(n * n);
+  double own = var_mean / (10.25 * 10.25 + kRelMseEpsilon) / (w * h);   // divided by its own mean
+  double neighbourhood = var_mean / (0.5 * 0.5 + kRelMseEpsilon) / (w * h);
+  EXPECT_NEAR(firefly - quiet, neighbourhood, 0.01 * neighbourhood) << "own-mean figure: " << own;
+  // Bright edge: both halves about 10, no more noisy than its neighbours relative to its mean.
+  double edge = estimate_with_centre(9.8, 10.2);
+  double edge_var = 0.4 * 0.4 * p * (n - p) / double(n * n);
+  EXPECT_NEAR(edge - quiet, edge_var / (10.0 * 10.0 + kRelMseEpsilon) / (w * h) - quiet / (w * h), 1e-8);
+}
