@@ -78,11 +78,7 @@ void splat_to_camera(const RenderScene& scene, const CausticFilm& film, const Su
   // The path tracer's shading frame at its first vertex: opaque, normals turned to the viewer.
   Vec3 wo_world = -v / dist, wi_world = -arriving;
   Vec3 ng = hit.ng, ns = hit.ns;
-  if (dot(wo_world, ng) < 0) {
-    ng = -ng;
-    ns = -ns;
-  }
-  if (dot(wo_world, ns) <= 0) ns = ng;
+  face_viewer(wo_world, false, ng, ns);
   float cos_wi_g = dot(wi_world, ng), cos_wo_g = dot(wo_world, ng);
   if (cos_wi_g <= 0 || cos_wo_g <= 0) return;  // the path tracer bounces on the viewer's side only
   Frame frame(ns);
@@ -203,11 +199,7 @@ void trace_caustic_path(const RenderScene& scene, const RenderParams& params, co
     if (vertex + 1 > params.max_depth) return;  // no room for another vertex
     Vec3 wo_world = -ray.d, ng = hit.ng, ns = hit.ns;
     bool transmissive = is_transmissive(m);
-    if (!transmissive && dot(wo_world, ng) < 0) {
-      ng = -ng;
-      ns = -ns;
-    }
-    if (!transmissive && dot(wo_world, ns) <= 0) ns = ng;
+    face_viewer(wo_world, transmissive, ng, ns);
     Frame frame(ns);
     float u_lobe = rng.next_float();
     Vec2 u = rng.next_2d();

@@ -130,9 +130,7 @@ FilmAccumulator::FilmAccumulator(const RenderParams& params, int width, int heig
 }
 
 Vec3 FilmAccumulator::pixel_mean(size_t i) const {
-  Vec3 v = m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f);
-  if (m_lt_paths > 0) v += m_lt_sum[i] / float(m_lt_paths);
-  return v;
+  return pixel_estimate(m_sum[i], m_count[i], m_lt_sum, m_lt_paths, i);
 }
 
 void FilmAccumulator::merge(const FilmPass& pass) {

@@ -166,11 +166,7 @@ Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray,
     // Shading frame. Opaque surfaces are two-sided: turn the normals towards the viewer.
     Vec3 ng = hit.ng, ns = hit.ns;
     bool transmissive = has_transmission<F>(material);
-    if (!transmissive && dot(wo_world, ng) < 0) {
-      ng = -ng;
-      ns = -ns;
-    }
-    if (!transmissive && dot(wo_world, ns) <= 0) ns = ng;  // shading normal faces away: fall back
+    face_viewer(wo_world, transmissive, ng, ns);
     Vertex v{hit, material, Frame(ns), ng, Vec3()};
     v.wo = v.frame.to_local(wo_world);
 

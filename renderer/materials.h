@@ -34,6 +34,19 @@ inline bool diffuse_sample(const Material& m, Vec3 wo, Vec2 u, BsdfSample& s) {
   return true;
 }
 
+// The shading normals at a hit seen from wo (world space): opaque surfaces are two-sided, so their
+// normals turn to the viewer, and a shading normal facing away falls back to the geometric one.
+// Transmissive surfaces keep theirs (z > 0 is outside). Camera and light paths both use it, so
+// that they agree on every vertex they share.
+inline void face_viewer(Vec3 wo, bool transmissive, Vec3& ng, Vec3& ns) {
+  if (transmissive) return;
+  if (dot(wo, ng) < 0) {
+    ng = -ng;
+    ns = -ns;
+  }
+  if (dot(wo, ns) <= 0) ns = ng;
+}
+
 // True when the material has only delta lobes (no eval, no light sampling).
 bool is_delta(const Material& m);
 // True when light can pass through (the frame must not be flipped towards wo).

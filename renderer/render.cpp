@@ -526,9 +526,7 @@ void RenderSession::read_tile(const Tile& t, std::vector<Vec3>& out) const {
 }
 
 Vec3 RenderSession::pixel_mean(size_t i) const {
-  Vec3 v = m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f);
-  if (m_lt_paths > 0) v += m_lt_sum[i] / float(m_lt_paths);
-  return v;
+  return pixel_estimate(m_sum[i], m_count[i], m_lt_sum, m_lt_paths, i);
 }
 
 void RenderSession::set_sample_range(uint32_t first, const std::vector<uint8_t>& skip) {

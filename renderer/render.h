@@ -147,6 +147,15 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
                              const std::vector<double>& s1, const std::vector<double>& half_s1,
                              const SplatStats& splats = {});
 
+// A pixel's radiance: the mean of its camera samples plus, where caustics are light traced, its
+// splat sum over every light path traced (caustics.h). The session and the merged film both use it.
+inline Vec3 pixel_estimate(Vec3 sum, uint32_t count, const std::vector<Vec3>& splat_sums, uint64_t light_paths,
+                           size_t i) {
+  Vec3 v = count ? sum / float(count) : Vec3(0.0f);
+  if (light_paths > 0) v += splat_sums[i] / float(light_paths);
+  return v;
+}
+
 struct Tile {
   int x0, y0, x1, y1;  // film pixels, top-left origin, half-open
 };
