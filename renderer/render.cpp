@@ -166,6 +166,26 @@ SceneBase make_scene_base(const SceneDesc& desc) {
   base.camera = desc.camera;
   base.bounds = desc.geometry_bounds();
   base.caustic_targets = find_caustic_targets(desc, base.materials);
+  // Each object's box, padded as Accel pads the scene's (relative to the largest coordinate).
+  for (const MeshDesc& m : desc.meshes) {
+    Bounds3 b;
+    for (Vec3 p : m.positions) b.expand(p);
+    if (!b.empty()) base.object_bounds.push_back(b);
+  }
+  for (const SphereDesc& s : desc.spheres) {
+    Vec3 r(s.radius, s.radius, s.radius);
+    base.object_bounds.push_back({s.center - r, s.center + r});
+  }
+  for (const EmitterPanel& p : panels) {
+    Bounds3 b;
+    for (Vec3 v : p.v) b.expand(v);
+    base.object_bounds.push_back(b);
+  }
+  float size = 0;
+  for (const Bounds3& b : base.object_bounds)
+    size = std::max({size, max_component(abs(b.lo)), max_component(abs(b.hi)), max_component(b.hi - b.lo)});
+  const float pad = 1e-3f * size + 1e-6f;
+  for (Bounds3& b : base.object_bounds) b.lo = b.lo - Vec3(pad, pad, pad), b.hi = b.hi + Vec3(pad, pad, pad);
   base.source = desc.source;
   return base;
 }
@@ -209,6 +229,7 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
       rs->infinite_lights.push_back(int(i));
   rs->camera = make_camera(base.camera, base.bounds, camera_params(params));
   rs->caustic_targets = std::move(base.caustic_targets);
+  rs->object_bounds = std::move(base.object_bounds);
   std::vector<float> power;
   for (size_t i = 0; i < rs->lights.size(); ++i) {
     const Light& l = rs->lights[i];
@@ -282,34 +303,68 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
 // A thin lens sees a point at depth z from lens point l at sensor position p/z - l (1/z - 1/f)
 // (camera.cpp's ray through the focus point p f / z): the rectangle grows by the lens radius times
 // the largest |1/z - 1/f| over the box, which a corner (the nearest or farthest) attains.
-void RenderSession::find_scene_rectangle() {
-  const Camera& cam = m_scene.camera;
-  Vec3 lo, hi;
-  if (!m_scene.accel || !m_scene.accel->hit_bounds(lo, hi)) return;
-  if (!(cam.tan_half_w > 0) || !(cam.tan_half_h > 0)) return;
+namespace {
+
+// The frame-pixel rectangle (y up, unclipped, without margin) holding box [lo, hi] as the camera
+// sees it, or false when a corner lies beside or behind the camera (no rectangle holds it).
+bool project_box(const Camera& cam, int width, int height, Vec3 lo, Vec3 hi, float r[4]) {
   const bool lens = cam.lens_radius > 0;
-  if (lens && !(cam.focal_distance > 0 && std::isfinite(cam.focal_distance))) return;
   float u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf, blur = 0;
   for (int c = 0; c < 8; ++c) {
     Vec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
     Vec3 v = corner - cam.position;
     float z = -dot(v, cam.back);
-    if (!(z > 1e-3f * length(v))) return;  // a corner beside or behind the camera: no rectangle
-    float u = (dot(v, cam.right) / (z * cam.tan_half_w) + 1) * 0.5f * float(m_params.width);
-    float w = (dot(v, cam.up) / (z * cam.tan_half_h) + 1) * 0.5f * float(m_params.height);
-    if (!std::isfinite(u) || !std::isfinite(w)) return;
+    if (!(z > 1e-3f * length(v))) return false;
+    float u = (dot(v, cam.right) / (z * cam.tan_half_w) + 1) * 0.5f * float(width);
+    float w = (dot(v, cam.up) / (z * cam.tan_half_h) + 1) * 0.5f * float(height);
+    if (!std::isfinite(u) || !std::isfinite(w)) return false;
     u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, w), v1 = std::max(v1, w);
     if (lens) blur = std::max(blur, cam.lens_radius * std::fabs(1 / z - 1 / cam.focal_distance));
   }
   if (lens) {  // blur is in sensor units (tan); pixels per unit differ along x and y
-    float bu = blur * 0.5f * float(m_params.width) / cam.tan_half_w, bv = blur * 0.5f * float(m_params.height) / cam.tan_half_h;
-    if (!std::isfinite(bu) || !std::isfinite(bv)) return;
+    float bu = blur * 0.5f * float(width) / cam.tan_half_w, bv = blur * 0.5f * float(height) / cam.tan_half_h;
+    if (!std::isfinite(bu) || !std::isfinite(bv)) return false;
     u0 -= bu, u1 += bu, v0 -= bv, v1 += bv;
   }
-  m_scene_u0 = u0 - 1, m_scene_u1 = u1 + 1, m_scene_v0 = v0 - 1, m_scene_v1 = v1 + 1;
+  r[0] = u0, r[1] = u1, r[2] = v0, r[3] = v1;
+  return true;
+}
+
+}  // namespace
+
+void RenderSession::find_scene_rectangle() {
+  const Camera& cam = m_scene.camera;
+  Vec3 lo, hi;
+  if (!m_scene.accel || !m_scene.accel->hit_bounds(lo, hi)) return;
+  if (!(cam.tan_half_w > 0) || !(cam.tan_half_h > 0)) return;
+  if (cam.lens_radius > 0 && !(cam.focal_distance > 0 && std::isfinite(cam.focal_distance))) return;
+  float r[4];
+  if (!project_box(cam, m_params.width, m_params.height, lo, hi, r)) return;
+  m_scene_u0 = r[0] - 1, m_scene_u1 = r[1] + 1, m_scene_v0 = r[2] - 1, m_scene_v1 = r[3] + 1;
   // The caustic light paths are counted on this area (it may reach beyond a cropped frame).
-  m_scene_pixels = double(u1 - u0) * double(v1 - v0);
+  m_scene_pixels = double(r[1] - r[0]) * double(r[3] - r[2]);
   m_background_rect = m_scene.environment_light < 0;
+  if (!m_background_rect) return;
+
+  // Within the rectangle, the pixels no object's own rectangle reaches (the sky above an open
+  // floor): a film mask, for a bounded number of objects and pixels.
+  const auto& objects = m_scene.object_bounds;
+  if (objects.empty() || objects.size() > kMaxMaskedObjects || size_t(m_w) * m_h > (size_t(1) << 24)) return;
+  std::vector<uint8_t> mask(size_t(m_w) * m_h, 0);
+  for (const Bounds3& b : objects) {
+    if (!project_box(cam, m_params.width, m_params.height, b.lo, b.hi, r)) return;  // no mask: the rectangle only
+    // Film pixels whose frame pixel [fx, fx + 1] x [fy, fy + 1] meets the rectangle grown by a pixel.
+    auto px = [](float v, int size) { return int(std::clamp(v, -4.0f, float(size) + 4)); };
+    int fx0 = px(std::floor(r[0] - 2), m_params.width), fx1 = px(std::ceil(r[1] + 1), m_params.width);
+    int fy0 = px(std::floor(r[2] - 2), m_params.height), fy1 = px(std::ceil(r[3] + 1), m_params.height);
+    int x0 = std::max(fx0 - m_frame_x0, 0), x1 = std::min(fx1 - m_frame_x0, m_w - 1);
+    for (int fy_up = std::max(fy0, 0); fy_up <= std::min(fy1, m_params.height - 1); ++fy_up) {
+      int y = (m_params.height - 1 - fy_up) - m_frame_y0;
+      if (y < 0 || y >= m_h) continue;
+      for (int x = x0; x <= x1; ++x) mask[size_t(y) * m_w + x] = 1;
+    }
+  }
+  m_seen = std::move(mask);
 }
 
 void RenderSession::render_tile(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,

@@ -80,6 +80,7 @@ struct SceneBase {
   CameraDesc camera;                // what make_camera reads of the file
   Bounds3 bounds;
   std::vector<CausticTarget> caustic_targets;  // bounds of the delta-material geometry
+  std::vector<Bounds3> object_bounds;  // each mesh, sphere and light panel, padded as Accel pads its bounds
   std::string source;
 
   // Bytes held for rendering: BVH and geometry (Accel::memory_bytes), lights, materials.
@@ -98,6 +99,7 @@ struct RenderScene {
   size_t triangle_count = 0, sphere_count = 0;
   // What the caustic light tracer samples: delta geometry to aim at, area and mesh lights by power.
   std::vector<CausticTarget> caustic_targets;
+  std::vector<Bounds3> object_bounds;  // from SceneBase: what the background mask projects
   std::vector<int> caustic_lights;
   Distribution1D caustic_light_distribution;
 };
@@ -214,8 +216,13 @@ class RenderSession {
   // True when every camera ray of frame pixel (fx, fy_up) (y up, as the course counts rows) misses
   // the scene, so that its samples are black without a ray query (see find_scene_rectangle).
   bool sees_only_background(int fx, int fy_up) const {
-    return m_background_rect && (fx + 1 < m_scene_u0 || fx > m_scene_u1 || fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1);
+    if (!m_background_rect) return false;
+    if (fx + 1 < m_scene_u0 || fx > m_scene_u1 || fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1) return true;
+    int x = fx - m_frame_x0, y = (m_params.height - 1 - fy_up) - m_frame_y0;
+    return !m_seen.empty() && x >= 0 && y >= 0 && x < m_w && y < m_h && !m_seen[size_t(y) * m_w + x];
   }
+  // Objects whose own projected rectangles refine the scene's (find_scene_rectangle).
+  static constexpr size_t kMaxMaskedObjects = 256;
 
  private:
   void find_scene_rectangle();
@@ -234,6 +241,7 @@ class RenderSession {
   bool m_background_rect = false;
   float m_scene_u0 = 0, m_scene_u1 = 0, m_scene_v0 = 0, m_scene_v1 = 0;
   double m_scene_pixels = 0;  // the projected bounds' area, unclipped (0: unknown)
+  std::vector<uint8_t> m_seen;  // film pixels some object's rectangle reaches (empty: no mask)
   uint32_t m_first_sample = 0;
   std::vector<Tile> m_tiles;
   std::vector<Vec3> m_sum;

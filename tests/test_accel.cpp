@@ -151,7 +151,8 @@ bool ray_meets_box(const Ray& r, Vec3 lo, Vec3 hi) {
 }
 
 // Every pixel the session skips as background: no jittered camera ray through it reaches the box
-// the scene's hits lie in. Returns how many pixels were skipped.
+// of any object (nor the scene's box, outside the scene's rectangle), and none hits anything.
+// Returns how many pixels were skipped.
 int check_background_pixels(const RenderScene& scene, const RenderParams& p) {
   RenderSession session(scene, p);
   Vec3 lo, hi;
@@ -170,7 +171,11 @@ int check_background_pixels(const RenderScene& scene, const RenderParams& p) {
         float jx = k < 4 ? float(k & 1) : u(rng), jy = k < 4 ? float(k >> 1) : u(rng);
         Vec2 lens = k < 8 ? rim[k & 3] : Vec2{u(rng), u(rng)};
         Ray r = scene.camera.generate_ray((fx + jx) / p.width, (fy + jy) / p.height, lens);
-        if (ray_meets_box(r, lo, hi)) {
+        bool meets = false;
+        for (const Bounds3& b : scene.object_bounds) meets |= ray_meets_box(r, b.lo, b.hi);
+        if (scene.object_bounds.empty()) meets = ray_meets_box(r, lo, hi);
+        SurfaceHit h;
+        if (meets || scene.accel->intersect(r, h)) {
           ADD_FAILURE() << "pixel (" << fx << ", " << fy << ") is skipped as background but a ray through it meets the scene";
           return skipped;
         }
@@ -204,6 +209,28 @@ TEST(Background, SkippedPixelsSeeNoGeometry) {
   p.height = 120;
   p.keep_fov = true;
   check_background_pixels(*make_render_scene(cornell, p), p);
+}
+
+// Two small spheres far apart: the scene's rectangle holds both and the empty space between them;
+// the objects' own rectangles leave that space to the background shortcut.
+TEST(Background, ObjectRectanglesSkipTheEmptySpaceBetweenObjects) {
+  SceneDesc d;
+  d.materials.resize(1);
+  d.spheres.push_back({"a", Vec3(-2, -1.5f, 0), 0.3f, 0});
+  d.spheres.push_back({"b", Vec3(2, 1.5f, 0), 0.3f, 0});
+  for (float lens : {0.0f, 0.05f}) {
+    RenderParams p;
+    p.width = 120;
+    p.height = 90;
+    p.keep_fov = true;
+    p.lens_radius = lens;
+    auto scene = make_render_scene(d, p);
+    ASSERT_EQ(scene->object_bounds.size(), 2u);
+    int skipped = check_background_pixels(*scene, p);
+    RenderSession session(*scene, p);
+    EXPECT_TRUE(session.sees_only_background(p.width / 2, p.height / 2)) << "the centre, between the spheres";
+    EXPECT_GT(skipped, p.width * p.height * 8 / 10) << "lens " << lens;
+  }
 }
 
 TEST(Background, ThinLensSkipsOnlyPixelsNoLensPointSeesGeometryThrough) {
