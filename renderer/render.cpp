@@ -193,6 +193,7 @@ SceneBase make_scene_base(const SceneDesc& desc) {
 size_t SceneBase::memory_bytes() const {
   size_t bytes = accel ? accel->memory_bytes() : 0;
   bytes += materials.capacity() * sizeof(Material) + lights.capacity() * sizeof(Light);
+  bytes += object_bounds.capacity() * sizeof(Bounds3) + caustic_targets.capacity() * sizeof(CausticTarget);
   for (const Light& l : lights)  // mesh lights: corners, and the area distribution (float + double cdf)
     bytes += l.triangles.capacity() * sizeof(Vec3) + l.triangle_distribution.size() * (sizeof(float) + sizeof(double));
   return bytes;
