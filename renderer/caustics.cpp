@@ -141,17 +141,7 @@ void trace_caustic_path(const RenderScene& scene, const RenderParams& params, co
   size_t li = scene.caustic_light_distribution.sample_discrete(u_light.x, &p_light, &u_reuse);
   const Light& light = scene.lights[scene.caustic_lights[li]];
   Vec3 x0, n;
-  if (light.kind == LightKind::rect) {
-    x0 = light.position + light.dim_x * (u_point.x - 0.5f) + light.dim_y * (u_point.y - 0.5f);
-    n = light.direction;
-  } else {
-    float prob, ux;
-    size_t t = light.triangle_distribution.sample_discrete(u_point.x, &prob, &ux);
-    Vec2 b = sample_uniform_triangle({ux, u_point.y});
-    const Vec3* v = &light.triangles[3 * t];
-    x0 = v[0] * b.x + v[1] * b.y + v[2] * (1 - b.x - b.y);
-    n = normalize(cross(v[1] - v[0], v[2] - v[0]));
-  }
+  sample_area_light_point(light, u_point, x0, n);
 
   // A direction into the cone of one target, chosen in proportion to the cones' solid angles: the
   // pdf is the number of cones holding the direction over their total solid angle.

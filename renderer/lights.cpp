@@ -107,23 +107,27 @@ float EnvironmentMap::pdf(Vec3 dir) const {
 
 // ---- light sampling ----
 
+void sample_area_light_point(const Light& light, Vec2 u, Vec3& point, Vec3& normal) {
+  if (light.kind == LightKind::rect) {
+    point = light.position + light.dim_x * (u.x - 0.5f) + light.dim_y * (u.y - 0.5f);
+    normal = light.direction;
+    return;
+  }
+  float prob, ux;
+  size_t t = light.triangle_distribution.sample_discrete(u.x, &prob, &ux);
+  Vec2 b = sample_uniform_triangle({ux, u.y});
+  const Vec3* v = &light.triangles[3 * t];
+  point = v[0] * b.x + v[1] * b.y + v[2] * (1 - b.x - b.y);
+  normal = normalize(cross(v[1] - v[0], v[2] - v[0]));
+}
+
 bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s) {
   s.infinite = false;
   switch (light.kind) {
     case LightKind::rect:
     case LightKind::mesh: {
       Vec3 q, n;
-      if (light.kind == LightKind::rect) {
-        q = light.position + light.dim_x * (u.x - 0.5f) + light.dim_y * (u.y - 0.5f);
-        n = light.direction;
-      } else {
-        float prob, ux;
-        size_t t = light.triangle_distribution.sample_discrete(u.x, &prob, &ux);
-        Vec2 b = sample_uniform_triangle({ux, u.y});
-        const Vec3* v = &light.triangles[3 * t];
-        q = v[0] * b.x + v[1] * b.y + v[2] * (1 - b.x - b.y);
-        n = normalize(cross(v[1] - v[0], v[2] - v[0]));
-      }
+      sample_area_light_point(light, u, q, n);
       Vec3 d = q - p;
       float dist2 = length_squared(d);
       if (!(dist2 > 0)) return false;

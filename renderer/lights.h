@@ -60,6 +60,9 @@ struct LightSample {
   bool infinite = false;
 };
 
+// A point on an area emitter (rect or mesh), uniform by area, and the unit normal of the side it
+// emits to. Shared by light sampling and the caustic light paths that leave it.
+void sample_area_light_point(const Light& light, Vec2 u, Vec3& point, Vec3& normal);
 // Samples a direction towards the light from p. Returns false when the light cannot contribute.
 bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s);
 // Solid-angle pdf that sample_light would pick the direction from p to a point on an area
