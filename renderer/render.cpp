@@ -342,8 +342,13 @@ void RenderSession::find_scene_rectangle() {
   float r[4];
   if (!project_box(cam, m_params.width, m_params.height, lo, hi, r)) return;
   m_scene_u0 = r[0] - 1, m_scene_u1 = r[1] + 1, m_scene_v0 = r[2] - 1, m_scene_v1 = r[3] + 1;
-  // The caustic light paths are counted on this area (it may reach beyond a cropped frame).
-  m_scene_pixels = double(r[1] - r[0]) * double(r[3] - r[2]);
+  // The caustic light paths are counted on this area, clipped to the full frame (not to a crop or
+  // cell window, so that windows trace the frame's paths): a box around a close camera projects far
+  // past the frame, and light paths only splat inside it.
+  auto clipped = [](float a, float b, float size) {
+    return std::max(0.0, double(std::min(b, size)) - double(std::max(a, 0.0f)));
+  };
+  m_scene_pixels = clipped(m_scene_u0, m_scene_u1, float(m_params.width)) * clipped(m_scene_v0, m_scene_v1, float(m_params.height));
   m_background_rect = m_scene.environment_light < 0;
   if (!m_background_rect) return;
 
@@ -442,7 +447,7 @@ constexpr double kLightPathsPerScenePixel = 0.15, kMaxLightPathsPerSample = 1.0;
 // full frame), and a share of sample indices (set_sample_range) its share of light paths.
 uint64_t RenderSession::light_paths_for(uint64_t samples) const {
   const double frame = double(m_params.width) * m_params.height;
-  const double scene = m_scene_pixels > 0 ? m_scene_pixels : frame;
+  const double scene = m_scene_pixels >= 0 ? m_scene_pixels : frame;
   const double per_sample = std::min(kMaxLightPathsPerSample * frame, kLightPathsPerScenePixel * scene);
   return uint64_t(std::ceil(per_sample * double(samples)));
 }

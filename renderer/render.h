@@ -240,7 +240,7 @@ class RenderSession {
   // rectangle a sample is black and costs no ray query. Off (empty) for a visible environment.
   bool m_background_rect = false;
   float m_scene_u0 = 0, m_scene_u1 = 0, m_scene_v0 = 0, m_scene_v1 = 0;
-  double m_scene_pixels = 0;  // the projected bounds' area, unclipped (0: unknown)
+  double m_scene_pixels = -1;  // the projected bounds' area within the full frame (-1: unknown)
   std::vector<uint8_t> m_seen;  // film pixels some object's rectangle reaches (empty: no mask)
   uint32_t m_first_sample = 0;
   std::vector<Tile> m_tiles;
