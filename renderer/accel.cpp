@@ -406,12 +406,55 @@ bool Accel::occluded(const Ray& ray) const {
   return r.tfar < 0;  // Embree sets tfar = -inf on a hit
 }
 
-size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, size_t batch) const {
+namespace {
+
+// Packets of 16 rays of one kind (intersect or shadow) in the order they come; the last packet
+// masks its unused lanes.
+size_t cast_packets16(RTCScene scene, RTCIntersectContext& ctx, const Ray* rays, const uint8_t* shadow, size_t n) {
+  constexpr int W = 16;
+  alignas(64) RTCRayHit16 hits16;
+  alignas(64) RTCRay16 shadows16;
+  alignas(64) int valid[W];
+  size_t hits = 0;
+  for (int kind = 0; kind < 2; ++kind) {
+    RTCRay16& r16 = kind ? shadows16 : hits16.ray;
+    int lanes = 0;
+    auto flush = [&] {
+      for (int k = 0; k < W; ++k) valid[k] = k < lanes ? -1 : 0;
+      if (kind) {
+        rtcOccluded16(valid, scene, &ctx, &shadows16);
+        for (int k = 0; k < lanes; ++k) hits += shadows16.tfar[k] < 0;
+      } else {
+        rtcIntersect16(valid, scene, &ctx, &hits16);
+        for (int k = 0; k < lanes; ++k) hits += hits16.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+      }
+      lanes = 0;
+    };
+    for (size_t i = 0; i < n; ++i) {
+      if (shadow[i] != kind) continue;
+      const Ray& r = rays[i];
+      const int k = lanes++;
+      r16.org_x[k] = r.o.x, r16.org_y[k] = r.o.y, r16.org_z[k] = r.o.z;
+      r16.dir_x[k] = r.d.x, r16.dir_y[k] = r.d.y, r16.dir_z[k] = r.d.z;
+      r16.tnear[k] = r.tmin, r16.tfar[k] = r.tmax, r16.time[k] = 0;
+      r16.mask[k] = 0xFFFFFFFFu, r16.id[k] = 0, r16.flags[k] = 0;
+      if (!kind) hits16.hit.geomID[k] = hits16.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+      if (lanes == W) flush();
+    }
+    if (lanes) flush();
+  }
+  return hits;
+}
+
+}  // namespace
+
+size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode mode, size_t batch) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);  // incoherent rays, as a path tracer casts them
   RTCScene scene = m_impl->scene;
+  if (mode == RawMode::packet16) return cast_packets16(scene, ctx, rays, shadow, n);
   size_t hits = 0;
-  if (batch <= 1) {
+  if (mode == RawMode::single || batch <= 1) {
     for (size_t i = 0; i < n; ++i) {
       if (shadow[i]) {
         RTCRay r;

@@ -51,10 +51,13 @@ class Accel {
   bool hit_bounds(Vec3& lo, Vec3& hi) const;
 
   // Benchmarks only (bench/ceiling.cpp; the renderer never calls it): casts rays[0, n) straight
-  // through Embree, rtcIntersect1 / rtcOccluded1 per ray when batch <= 1, else Embree's stream API
-  // (rtcIntersect1M / rtcOccluded1M, `batch` rays a call, intersect and shadow rays gathered
-  // separately). shadow[i] != 0 makes ray i an occlusion query. Returns how many rays hit.
-  size_t cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, size_t batch) const;
+  // through Embree. single: rtcIntersect1 / rtcOccluded1 per ray; stream: rtcIntersect1M /
+  // rtcOccluded1M, `batch` rays a call; packet16: rtcIntersect16 / rtcOccluded16, 16 consecutive
+  // rays of a kind a call (what Mitsuba 3's LLVM variants call on AVX-512). Stream and packets
+  // gather intersect and shadow rays separately. shadow[i] != 0 makes ray i an occlusion query.
+  // Returns how many rays hit.
+  enum class RawMode { single, stream, packet16 };
+  size_t cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode mode, size_t batch) const;
 
   struct Impl;
 
