@@ -1,6 +1,6 @@
 // THE Embree file: builds the Embree 3 scene once and answers intersect / occluded queries.
-// Triangles (meshes and emitter panels) are Embree triangle geometry; spheres are Embree's exact
-// sphere primitive (RTC_GEOMETRY_TYPE_SPHERE_POINT), never tessellated.
+// Triangles (meshes and emitter panels) are Embree triangle geometry; spheres are Embree user
+// geometry with an exact test, never tessellated.
 #include "accel.h"
 
 #include <embree3/rtcore.h>
@@ -340,6 +340,62 @@ thread_local RayRecorder* t_recorder = nullptr;  // benchmarks only: see record_
 
 void record_rays_on_this_thread(RayRecorder* r) { t_recorder = r; }
 
+namespace {
+
+// The hit record from Embree's answer: the point refined from the barycentrics or the sphere
+// equation, unit normals, material and light. `eng` is Embree's unnormalised geometric normal.
+void refine_hit(const GeomInfo& g, const Ray& ray, unsigned prim, float t, float u, float v, Vec3 eng,
+                SurfaceHit& hit) {
+  hit.t = t;
+  if (g.kind == GeomKind::spheres) {
+    const float* s = g.spheres + 4 * prim;
+    Vec3 c(s[0], s[1], s[2]);
+    float r = s[3];
+    Vec3 p = ray.o + ray.d * t;
+    Vec3 n = normalize(p - c);
+    if (is_black(n)) n = Vec3(0, 1, 0);
+    hit.p = c + n * r;  // re-project onto the sphere: removes the error of o + t d
+    hit.ng = hit.ns = n;
+    hit.material = g.sphere_material[prim];
+    hit.light = -1;
+    // Embree's sphere test loses ~ulp(r)/cos near the surface; push far enough to clear it.
+    hit.offset = 1e-5f * r;
+    return;
+  }
+  const uint32_t* tri = g.indices + 3 * prim;
+  const TriangleInfo& info = g.tris[prim];
+  auto P = [&](uint32_t i) { return Vec3(g.positions[3 * i], g.positions[3 * i + 1], g.positions[3 * i + 2]); };
+  float w = 1 - u - v;
+  hit.p = P(tri[0]) * w + P(tri[1]) * u + P(tri[2]) * v;
+  Vec3 ng = info.ng;
+  if (__builtin_expect(is_black(ng), 0)) {
+    ng = normalize(eng);
+    if (is_black(ng)) ng = Vec3(0, 1, 0);
+  }
+  hit.ng = ng;
+  if (!g.normals.empty()) {
+    Vec3 ns = normalize(g.normals[tri[0]] * w + g.normals[tri[1]] * u + g.normals[tri[2]] * v);
+    hit.ns = is_black(ns) ? ng : ns;
+  } else {
+    hit.ns = ng;
+  }
+  hit.material = info.material;
+  hit.light = info.light;
+  hit.offset = 0;
+}
+
+// One packet lane from a ray. Masked-off lanes of a partial packet also get a valid ray (a copy of
+// lane 0): where the CPU lacks 16-wide kernels, Embree splits the packet and its debug build
+// asserts on the rays of lanes it should ignore (seen under valgrind, which has no AVX-512).
+inline void to_lane(const Ray& r, RTCRay16& e, int k) {
+  e.org_x[k] = r.o.x, e.org_y[k] = r.o.y, e.org_z[k] = r.o.z;
+  e.dir_x[k] = r.d.x, e.dir_y[k] = r.d.y, e.dir_z[k] = r.d.z;
+  e.tnear[k] = r.tmin, e.tfar[k] = r.tmax, e.time[k] = 0;
+  e.mask[k] = 0xFFFFFFFFu, e.id[k] = 0, e.flags[k] = 0;
+}
+
+}  // namespace
+
 bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(ray, 0);
   if (!embree_accepts(ray)) return false;
@@ -353,46 +409,70 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(m_impl->scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-
-  const GeomInfo& g = m_impl->geoms[rh.hit.geomID];
-  unsigned prim = rh.hit.primID;
-  hit.t = rh.ray.tfar;
-  if (g.kind == GeomKind::spheres) {
-    const float* s = g.spheres + 4 * prim;
-    Vec3 c(s[0], s[1], s[2]);
-    float r = s[3];
-    Vec3 p = ray.o + ray.d * hit.t;
-    Vec3 n = normalize(p - c);
-    if (is_black(n)) n = Vec3(0, 1, 0);
-    hit.p = c + n * r;  // re-project onto the sphere: removes the error of o + t d
-    hit.ng = hit.ns = n;
-    hit.material = g.sphere_material[prim];
-    hit.light = -1;
-    // Embree's sphere test loses ~ulp(r)/cos near the surface; push far enough to clear it.
-    hit.offset = 1e-5f * r;
-    return true;
-  }
-  const uint32_t* tri = g.indices + 3 * prim;
-  const TriangleInfo& info = g.tris[prim];
-  auto P = [&](uint32_t i) { return Vec3(g.positions[3 * i], g.positions[3 * i + 1], g.positions[3 * i + 2]); };
-  float u = rh.hit.u, v = rh.hit.v, w = 1 - u - v;
-  hit.p = P(tri[0]) * w + P(tri[1]) * u + P(tri[2]) * v;
-  Vec3 ng = info.ng;
-  if (__builtin_expect(is_black(ng), 0)) {
-    ng = normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
-    if (is_black(ng)) ng = Vec3(0, 1, 0);
-  }
-  hit.ng = ng;
-  if (!g.normals.empty()) {
-    Vec3 ns = normalize(g.normals[tri[0]] * w + g.normals[tri[1]] * u + g.normals[tri[2]] * v);
-    hit.ns = is_black(ns) ? ng : ns;
-  } else {
-    hit.ns = ng;
-  }
-  hit.material = info.material;
-  hit.light = info.light;
-  hit.offset = 0;
+  refine_hit(a.geoms[rh.hit.geomID], ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v,
+             Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), hit);
   return true;
+}
+
+void Accel::intersect_many(const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found) const {
+  const Impl& a = *m_impl;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  alignas(64) RTCRayHit16 rh;
+  alignas(64) int valid[16];
+  uint32_t lane_ray[16];
+  int lanes = 0;
+  auto flush = [&] {
+    for (int k = 0; k < 16; ++k) valid[k] = k < lanes ? -1 : 0;
+    for (int k = lanes; k < 16; ++k) to_lane(rays[lane_ray[0]], rh.ray, k);  // see to_lane
+    rtcIntersect16(valid, a.scene, &ctx, &rh);
+    for (int k = 0; k < lanes; ++k) {
+      const uint32_t i = lane_ray[k];
+      if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
+      found[i] = 1;
+      refine_hit(a.geoms[rh.hit.geomID[k]], rays[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
+                 Vec3(rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]), hits[i]);
+    }
+    lanes = 0;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    found[i] = 0;
+    const Ray& r = rays[i];
+    if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(r, 0);
+    if (!embree_accepts(r) || (a.cull && !may_hit_bounds(r, a.lo, a.hi))) continue;
+    to_lane(r, rh.ray, lanes);
+    rh.hit.geomID[lanes] = rh.hit.instID[0][lanes] = RTC_INVALID_GEOMETRY_ID;
+    lane_ray[lanes] = uint32_t(i);
+    if (++lanes == 16) flush();
+  }
+  if (lanes) flush();
+}
+
+void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {
+  const Impl& a = *m_impl;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  alignas(64) RTCRay16 r16;
+  alignas(64) int valid[16];
+  uint32_t lane_ray[16];
+  int lanes = 0;
+  auto flush = [&] {
+    for (int k = 0; k < 16; ++k) valid[k] = k < lanes ? -1 : 0;
+    for (int k = lanes; k < 16; ++k) to_lane(rays[lane_ray[0]], r16, k);  // see to_lane
+    rtcOccluded16(valid, a.scene, &ctx, &r16);
+    for (int k = 0; k < lanes; ++k) blocked[lane_ray[k]] = r16.tfar[k] < 0;  // -inf on a hit
+    lanes = 0;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    blocked[i] = 0;
+    const Ray& r = rays[i];
+    if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(r, 1);
+    if (!embree_accepts(r)) continue;
+    to_lane(r, r16, lanes);
+    lane_ray[lanes] = uint32_t(i);
+    if (++lanes == 16) flush();
+  }
+  if (lanes) flush();
 }
 
 bool Accel::occluded(const Ray& ray) const {
@@ -419,8 +499,10 @@ size_t cast_packets16(RTCScene scene, RTCIntersectContext& ctx, const Ray* rays,
   for (int kind = 0; kind < 2; ++kind) {
     RTCRay16& r16 = kind ? shadows16 : hits16.ray;
     int lanes = 0;
+    std::vector<size_t> lane_ray(W);
     auto flush = [&] {
       for (int k = 0; k < W; ++k) valid[k] = k < lanes ? -1 : 0;
+      for (int k = lanes; k < W; ++k) to_lane(rays[lane_ray[0]], r16, k);  // see to_lane
       if (kind) {
         rtcOccluded16(valid, scene, &ctx, &shadows16);
         for (int k = 0; k < lanes; ++k) hits += shadows16.tfar[k] < 0;
@@ -432,12 +514,9 @@ size_t cast_packets16(RTCScene scene, RTCIntersectContext& ctx, const Ray* rays,
     };
     for (size_t i = 0; i < n; ++i) {
       if (shadow[i] != kind) continue;
-      const Ray& r = rays[i];
       const int k = lanes++;
-      r16.org_x[k] = r.o.x, r16.org_y[k] = r.o.y, r16.org_z[k] = r.o.z;
-      r16.dir_x[k] = r.d.x, r16.dir_y[k] = r.d.y, r16.dir_z[k] = r.d.z;
-      r16.tnear[k] = r.tmin, r16.tfar[k] = r.tmax, r16.time[k] = 0;
-      r16.mask[k] = 0xFFFFFFFFu, r16.id[k] = 0, r16.flags[k] = 0;
+      to_lane(rays[i], r16, k);
+      lane_ray[size_t(k)] = i;
       if (!kind) hits16.hit.geomID[k] = hits16.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
       if (lanes == W) flush();
     }

@@ -73,6 +73,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--keep-fov") { p.keep_fov = true; }
     else if (a == "--generic") { p.generic = true; }
     else if (a == "--no-caustic-tracing") { p.caustic_tracing = false; }
+    else if (a == "--no-ray-packets") { p.ray_packets = false; }
     else if (a == "--sampler") {
       need(a, 1);
       std::string v = args[++i];
@@ -141,6 +142,7 @@ std::string usage_text(const std::string& program) {
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
 "  --generic       run the path loop with every feature (for comparisons with the specialised one)\n"
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
+"  --no-ray-packets      trace camera paths one at a time instead of many in Embree packets of 16\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"
 "\n"
 "Error against run time:\n"
@@ -190,6 +192,7 @@ Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
           {"pathtracer:focal_distance", num(p.focal_distance)},
           {"pathtracer:adaptive", p.adaptive ? std::to_string(p.adaptive_batch) + " " + num(p.adaptive_tolerance) : "off"},
           {"pathtracer:direct", p.hemisphere ? "hemisphere" : "light sampling"},
+          {"pathtracer:ray_packets", p.ray_packets && !p.hemisphere ? "16" : "off"},
           {"pathtracer:caustic_light_paths", std::to_string(st.light_paths)},
           {"pathtracer:environment", p.env_map},
           {"pathtracer:seed", std::to_string(p.seed)},

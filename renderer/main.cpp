@@ -37,6 +37,8 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
               f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
+  std::printf("ray queries:      %s\n",
+              o.params.ray_packets && !o.params.hemisphere ? "paths in packets of 16" : "one path at a time");
   std::printf("render memory:    %.2f MiB (%.1f bytes per primitive: BVH, vertices, indices, shading data)\n",
               bytes / 1048576.0, prims ? double(bytes) / prims : 0.0);
   std::printf("load + build:     %.3f s\n", load_s);

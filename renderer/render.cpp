@@ -373,64 +373,6 @@ void RenderSession::find_scene_rectangle() {
   m_seen = std::move(mask);
 }
 
-void RenderSession::render_tile(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,
-                                uint64_t& samples, uint64_t& nonfinite) {
-  const RenderParams& p = m_params;
-  const Camera& cam = m_scene.camera;
-  const bool adaptive = p.adaptive;
-  const PathTracer trace = path_tracer_for(m_scene.features.bits);
-  const int batch = std::max(1, p.adaptive_batch);
-  for (int y = t.y0; y < t.y1; ++y) {
-    if (stop_requested(cancel)) return;
-    for (int x = t.x0; x < t.x1; ++x) {
-      size_t i = size_t(y) * m_w + x;
-      if (m_done[i]) continue;
-      int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
-      int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
-      uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
-      const bool background = sees_only_background(fx, fy_up);
-      uint32_t before = m_count[i];
-      while (m_count[i] < uint32_t(target)) {
-        uint32_t s = m_count[i];
-        if ((s & 15) == 15 && stop_requested(cancel)) break;
-        Vec3 l(0.0f);
-        if (background) {
-          ++rays;  // the camera ray the path loop would have cast and missed
-        } else {
-          Sampler rng(p.sampler, p.seed, pixel_index, m_first_sample + s);
-          Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
-          Vec2 lens = cam.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};  // a pinhole needs none
-          Ray ray = cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
-          l = trace(m_scene, p, ray, rng, rays);
-        }
-        if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
-          ++nonfinite;
-          l = Vec3(0.0f);
-        }
-        if (s > 0 && (s & (s - 1)) == 0) {  // s samples so far, a power of two: keep their sum
-          m_half_s1[i] = m_s1[i];
-          m_half_n[i] = s;
-        }
-        m_sum[i] += l;
-        double lum = luminance(l);
-        m_s1[i] += lum;
-        m_s2[i] += lum * lum;
-        uint32_t n = ++m_count[i];
-        ++samples;
-        // Course adaptive sampling: after sample index n-1 > 0 that is a multiple of the batch,
-        // stop once the 95% confidence half-width is within tolerance x mean.
-        if (adaptive && n > 1 && (n - 1) % batch == 0 && confidence_reached(m_s1[i], m_s2[i], n, p.adaptive_tolerance)) {
-          m_done[i] = 1;
-          break;
-        }
-      }
-      if (m_count[i] >= uint32_t(p.spp)) m_done[i] = 1;
-      uint64_t credit = m_done[i] ? uint64_t(p.spp) - before : uint64_t(m_count[i] - before);
-      m_budget_done.fetch_add(credit, std::memory_order_relaxed);
-    }
-  }
-}
-
 // Light paths per sample and pixel of the area where the scene's bounds project (find_scene_rectangle),
 // so that the splats per pixel do not depend on the framing. The light paths are aimed at the delta
 // geometry and most of them splat, so few are needed: on CBspheres at 480x360 (m = 5, 64 spp; the

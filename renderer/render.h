@@ -42,6 +42,7 @@ struct RenderParams {
   uint64_t seed = 0;               // --seed
   int tile_size = 32;
   bool generic = false;            // --generic: the path loop with every feature (for comparisons)
+  bool ray_packets = true;         // --no-ray-packets: trace paths one at a time, not in packets of 16
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
   bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
   // Set by RenderSession, not by users: its light tracer renders the caustic paths (caustics.h),
@@ -125,6 +126,12 @@ Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, c
 // The path loop specialised for a set of feature bits (one instantiation per combination).
 using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class Sampler&, uint64_t&);
 PathTracer path_tracer_for(uint32_t feature_bits);
+// The same paths, many at once: traces camera_rays[0, n) with samplers rngs[0, n) (each already
+// past its pixel and lens draws) and writes each path's radiance to out[i]. Rays go to Embree in
+// packets of 16. nullptr where the scalar loop must run (-H).
+using PathBatchTracer = void (*)(const RenderScene&, const RenderParams&, const Ray* camera_rays, class Sampler* rngs,
+                                 size_t n, Vec3* out, uint64_t& rays);
+PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const RenderParams& params);
 
 // The course's adaptive-sampling test for one pixel with n > 1 luminance samples of sum s1 and
 // sum of squares s2: the 95% confidence half-width is within tolerance x mean. Shared by the
@@ -229,8 +236,14 @@ class RenderSession {
   void trace_caustics(int target_spp, const std::atomic<bool>* cancel);
   uint64_t light_paths_for(uint64_t samples) const;
   Vec3 pixel_mean(size_t i) const;
+  // render_tile.cpp: a tile's samples up to target_spp, path by path or in packets.
   void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
                    uint64_t& samples, uint64_t& nonfinite);
+  void render_tile_batched(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
+                           uint64_t& samples, uint64_t& nonfinite, PathBatchTracer trace);
+  // Adds sample s of pixel i; true when the course's adaptive test stops the pixel there.
+  bool add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples, uint64_t& nonfinite);
+  Ray camera_ray(int fx, int fy_up, Sampler& rng) const;
 
   const RenderScene& m_scene;
   RenderParams m_params;

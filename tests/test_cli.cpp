@@ -137,7 +137,7 @@ TEST(Cli, HelpDocumentsEveryFlag) {
   RunResult r = run("--help");
   EXPECT_EQ(r.status, 0);
   for (const char* f : {"-s ", "-l ", "-t ", "-m ", "-e ", "-b ", "-d ", "-f ", "-r ", "-c ", "-a ", "-p ", "-H ",
-                        "-h", "--file-camera", "--seed", "--no-adaptive", "--no-caustic-tracing"})
+                        "-h", "--file-camera", "--seed", "--no-adaptive", "--no-caustic-tracing", "--no-ray-packets"})
     EXPECT_NE(r.output.find(f), std::string::npos) << f;
 }
 
@@ -199,6 +199,11 @@ TEST(Cli, DescribePrintsTheFeatureSetAndMemory) {
   EXPECT_NE(r.output.find("caustics:         light traced"), std::string::npos) << r.output;
   r = run("--describe --generic " + test::own_scene("cornell.dae"));
   EXPECT_NE(r.output.find("path loop:        generic"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("ray queries:      paths in packets of 16"), std::string::npos) << r.output;
+  r = run("--describe --no-ray-packets " + test::own_scene("cornell.dae"));
+  EXPECT_NE(r.output.find("ray queries:      one path at a time"), std::string::npos) << r.output;
+  r = run("--describe -H " + test::own_scene("cornell.dae"));  // its direct-light rays go one at a time
+  EXPECT_NE(r.output.find("ray queries:      one path at a time"), std::string::npos) << r.output;
   r = run("-s 16 -m 5 --describe --no-caustic-tracing " + test::own_scene("cornell.dae"));
   EXPECT_NE(r.output.find("caustics:         path traced only"), std::string::npos) << r.output;
   r = run("-s 16 -m 5 --describe " + test::own_scene("dof.dae"));  // no mirror or glass: nothing to trace

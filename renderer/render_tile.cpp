@@ -1,0 +1,164 @@
+// A tile's samples for one pass: camera rays, the path loop (one path at a time, or many paths
+// in Embree packets of 16), and the per-pixel statistics every estimate and stop rule reads.
+#include <algorithm>
+
+#include "render.h"
+
+namespace pt {
+
+Ray RenderSession::camera_ray(int fx, int fy_up, Sampler& rng) const {
+  const RenderParams& p = m_params;
+  const Camera& cam = m_scene.camera;
+  Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
+  Vec2 lens = cam.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};  // a pinhole needs none
+  return cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
+}
+
+bool RenderSession::add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples, uint64_t& nonfinite) {
+  if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
+    ++nonfinite;
+    l = Vec3(0.0f);
+  }
+  if (s > 0 && (s & (s - 1)) == 0) {  // s samples so far, a power of two: keep their sum
+    m_half_s1[i] = m_s1[i];
+    m_half_n[i] = s;
+  }
+  m_sum[i] += l;
+  double lum = luminance(l);
+  m_s1[i] += lum;
+  m_s2[i] += lum * lum;
+  uint32_t n = ++m_count[i];
+  ++samples;
+  // Course adaptive sampling: after sample index n-1 > 0 that is a multiple of the batch, stop once
+  // the 95% confidence half-width is within tolerance x mean.
+  const int batch = std::max(1, m_params.adaptive_batch);
+  return m_params.adaptive && n > 1 && (n - 1) % batch == 0 &&
+         confidence_reached(m_s1[i], m_s2[i], n, m_params.adaptive_tolerance);
+}
+
+void RenderSession::render_tile(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,
+                                uint64_t& samples, uint64_t& nonfinite) {
+  const RenderParams& p = m_params;
+  if (p.ray_packets) {
+    if (PathBatchTracer many = path_batch_tracer_for(m_scene.features.bits, p)) {
+      render_tile_batched(t, target, cancel, rays, samples, nonfinite, many);
+      return;
+    }
+  }
+  const PathTracer trace = path_tracer_for(m_scene.features.bits);
+  for (int y = t.y0; y < t.y1; ++y) {
+    if (stop_requested(cancel)) return;
+    for (int x = t.x0; x < t.x1; ++x) {
+      size_t i = size_t(y) * m_w + x;
+      if (m_done[i]) continue;
+      int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
+      int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
+      uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
+      const bool background = sees_only_background(fx, fy_up);
+      uint32_t before = m_count[i];
+      while (m_count[i] < uint32_t(target)) {
+        uint32_t s = m_count[i];
+        if ((s & 15) == 15 && stop_requested(cancel)) break;
+        Vec3 l(0.0f);
+        if (background) {
+          ++rays;  // the camera ray the path loop would have cast and missed
+        } else {
+          Sampler rng(p.sampler, p.seed, pixel_index, m_first_sample + s);
+          l = trace(m_scene, p, camera_ray(fx, fy_up, rng), rng, rays);
+        }
+        if (add_sample(i, s, l, samples, nonfinite)) {
+          m_done[i] = 1;
+          break;
+        }
+      }
+      if (m_count[i] >= uint32_t(p.spp)) m_done[i] = 1;
+      uint64_t credit = m_done[i] ? uint64_t(p.spp) - before : uint64_t(m_count[i] - before);
+      m_budget_done.fetch_add(credit, std::memory_order_relaxed);
+    }
+  }
+}
+
+// The same samples as render_tile's loop, gathered into batches of jobs (pixel, sample) that the
+// batch tracer runs together, then added to the pixels in each pixel's sample order: the images
+// equal the scalar loop's up to the packet kernel's rounding of a few hits. With adaptive sampling
+// a pixel's jobs stop at its next stop test, so rounds over the tile continue the pixels it
+// leaves running.
+void RenderSession::render_tile_batched(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,
+                                        uint64_t& samples, uint64_t& nonfinite, PathBatchTracer trace) {
+  const RenderParams& p = m_params;
+  const uint32_t batch = uint32_t(std::max(1, p.adaptive_batch));
+  constexpr size_t kJobs = 2048;  // paths per batch: bounds memory and the latency of a cancel
+  struct Job {
+    uint32_t pixel, sample;
+    int32_t traced;  // index into the batch's rays, or -1 for a background sample
+  };
+  std::vector<Job> jobs;
+  std::vector<Ray> camera_rays;
+  std::vector<Sampler> rngs;
+  std::vector<Vec3> out;
+  // Each pixel's count before this pass, for the progress credit; kDone: finished before it.
+  constexpr uint32_t kDone = ~0u;
+  const int tw = t.x1 - t.x0;
+  std::vector<uint32_t> before(size_t(tw) * (t.y1 - t.y0));
+  for (int y = t.y0; y < t.y1; ++y)
+    for (int x = t.x0; x < t.x1; ++x) {
+      size_t i = size_t(y) * m_w + x;
+      before[size_t(y - t.y0) * tw + (x - t.x0)] = m_done[i] ? kDone : m_count[i];
+    }
+
+  bool stopped = false;
+  auto flush = [&] {
+    out.resize(camera_rays.size());
+    if (!camera_rays.empty()) trace(m_scene, p, camera_rays.data(), rngs.data(), camera_rays.size(), out.data(), rays);
+    for (const Job& j : jobs) {
+      if (j.traced < 0) ++rays;  // the camera ray the path loop would have cast and missed
+      if (add_sample(j.pixel, j.sample, j.traced < 0 ? Vec3(0.0f) : out[size_t(j.traced)], samples, nonfinite))
+        m_done[j.pixel] = 1;
+    }
+    jobs.clear();
+    camera_rays.clear();
+    rngs.clear();
+    stopped = stop_requested(cancel);
+  };
+  for (bool again = true; again && !stopped;) {
+    again = false;
+    for (int y = t.y0; y < t.y1 && !stopped; ++y) {
+      for (int x = t.x0; x < t.x1 && !stopped; ++x) {
+        size_t i = size_t(y) * m_w + x;
+        uint32_t c = m_count[i];
+        if (m_done[i] || c >= uint32_t(target)) continue;
+        int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
+        int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
+        uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
+        const bool background = sees_only_background(fx, fy_up);
+        uint32_t end = uint32_t(target);
+        if (p.adaptive) {  // up to the next stop test: after sample n with n > 1 and n - 1 a multiple of the batch
+          uint32_t test = 1 + batch * ((std::max(c, 1u) + batch - 1) / batch);
+          if (test < end) end = test, again = true;
+        }
+        for (uint32_t s = c; s < end; ++s) {
+          if (background) {
+            jobs.push_back({uint32_t(i), s, -1});
+            continue;
+          }
+          rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
+          camera_rays.push_back(camera_ray(fx, fy_up, rngs.back()));
+          jobs.push_back({uint32_t(i), s, int32_t(camera_rays.size() - 1)});
+        }
+        if (jobs.size() >= kJobs) flush();
+      }
+    }
+    if (!jobs.empty()) flush();
+  }
+  for (int y = t.y0; y < t.y1; ++y)
+    for (int x = t.x0; x < t.x1; ++x) {
+      size_t i = size_t(y) * m_w + x;
+      if (m_count[i] >= uint32_t(p.spp)) m_done[i] = 1;
+      uint32_t b = before[size_t(y - t.y0) * tw + (x - t.x0)];
+      if (b == kDone) continue;
+      uint64_t credit = m_done[i] ? uint64_t(p.spp) - b : uint64_t(m_count[i] - b);
+      m_budget_done.fetch_add(credit, std::memory_order_relaxed);
+    }
+}
+
+}  // namespace pt
