@@ -384,15 +384,33 @@ void refine_hit(const GeomInfo& g, const Ray& ray, unsigned prim, float t, float
   hit.offset = 0;
 }
 
-// One packet lane from a ray. Masked-off lanes of a partial packet also get a valid ray (a copy of
-// lane 0): where the CPU lacks 16-wide kernels, Embree splits the packet and its debug build
-// asserts on the rays of lanes it should ignore (seen under valgrind, which has no AVX-512).
+// One packet lane from a ray.
 inline void to_lane(const Ray& r, RTCRay16& e, int k) {
   e.org_x[k] = r.o.x, e.org_y[k] = r.o.y, e.org_z[k] = r.o.z;
   e.dir_x[k] = r.d.x, e.dir_y[k] = r.d.y, e.dir_z[k] = r.d.z;
   e.tnear[k] = r.tmin, e.tfar[k] = r.tmax, e.time[k] = 0;
   e.mask[k] = 0xFFFFFFFFu, e.id[k] = 0, e.flags[k] = 0;
 }
+
+// Which ray of the caller's array each lane of a packet of 16 holds, and Embree's valid mask.
+struct Lanes16 {
+  alignas(64) int valid[16];
+  uint32_t ray[16];
+  int used = 0;
+
+  bool add(const Ray* rays, uint32_t i, RTCRay16& packet) {
+    to_lane(rays[i], packet, used);
+    ray[used] = i;
+    return ++used == 16;
+  }
+  // Before tracing: masked-off lanes of a partial packet also get a valid ray (a copy of lane 0).
+  // Where the CPU lacks 16-wide kernels Embree splits the packet, and its debug build asserted on
+  // the stale rays of lanes it should ignore (seen under valgrind, which has no AVX-512).
+  void seal(const Ray* rays, RTCRay16& packet) {
+    for (int k = 0; k < 16; ++k) valid[k] = k < used ? -1 : 0;
+    for (int k = used; k < 16; ++k) to_lane(rays[ray[0]], packet, k);
+  }
+};
 
 }  // namespace
 
@@ -419,33 +437,28 @@ void Accel::intersect_many(const Ray* rays, size_t n, SurfaceHit* hits, uint8_t*
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   alignas(64) RTCRayHit16 rh;
-  alignas(64) int valid[16];
-  uint32_t lane_ray[16];
-  int lanes = 0;
-  auto flush = [&] {
-    for (int k = 0; k < 16; ++k) valid[k] = k < lanes ? -1 : 0;
-    for (int k = lanes; k < 16; ++k) to_lane(rays[lane_ray[0]], rh.ray, k);  // see to_lane
-    rtcIntersect16(valid, a.scene, &ctx, &rh);
-    for (int k = 0; k < lanes; ++k) {
-      const uint32_t i = lane_ray[k];
+  Lanes16 lanes;
+  auto trace = [&] {
+    lanes.seal(rays, rh.ray);
+    rtcIntersect16(lanes.valid, a.scene, &ctx, &rh);
+    for (int k = 0; k < lanes.used; ++k) {
+      const uint32_t i = lanes.ray[k];
       if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
       found[i] = 1;
       refine_hit(a.geoms[rh.hit.geomID[k]], rays[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
                  Vec3(rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]), hits[i]);
     }
-    lanes = 0;
+    lanes.used = 0;
   };
   for (size_t i = 0; i < n; ++i) {
     found[i] = 0;
     const Ray& r = rays[i];
     if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(r, 0);
     if (!embree_accepts(r) || (a.cull && !may_hit_bounds(r, a.lo, a.hi))) continue;
-    to_lane(r, rh.ray, lanes);
-    rh.hit.geomID[lanes] = rh.hit.instID[0][lanes] = RTC_INVALID_GEOMETRY_ID;
-    lane_ray[lanes] = uint32_t(i);
-    if (++lanes == 16) flush();
+    rh.hit.geomID[lanes.used] = rh.hit.instID[0][lanes.used] = RTC_INVALID_GEOMETRY_ID;
+    if (lanes.add(rays, uint32_t(i), rh.ray)) trace();
   }
-  if (lanes) flush();
+  if (lanes.used) trace();
 }
 
 void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {
@@ -453,26 +466,21 @@ void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   alignas(64) RTCRay16 r16;
-  alignas(64) int valid[16];
-  uint32_t lane_ray[16];
-  int lanes = 0;
-  auto flush = [&] {
-    for (int k = 0; k < 16; ++k) valid[k] = k < lanes ? -1 : 0;
-    for (int k = lanes; k < 16; ++k) to_lane(rays[lane_ray[0]], r16, k);  // see to_lane
-    rtcOccluded16(valid, a.scene, &ctx, &r16);
-    for (int k = 0; k < lanes; ++k) blocked[lane_ray[k]] = r16.tfar[k] < 0;  // -inf on a hit
-    lanes = 0;
+  Lanes16 lanes;
+  auto trace = [&] {
+    lanes.seal(rays, r16);
+    rtcOccluded16(lanes.valid, a.scene, &ctx, &r16);
+    for (int k = 0; k < lanes.used; ++k) blocked[lanes.ray[k]] = r16.tfar[k] < 0;  // -inf on a hit
+    lanes.used = 0;
   };
   for (size_t i = 0; i < n; ++i) {
     blocked[i] = 0;
     const Ray& r = rays[i];
     if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(r, 1);
     if (!embree_accepts(r)) continue;
-    to_lane(r, r16, lanes);
-    lane_ray[lanes] = uint32_t(i);
-    if (++lanes == 16) flush();
+    if (lanes.add(rays, uint32_t(i), r16)) trace();
   }
-  if (lanes) flush();
+  if (lanes.used) trace();
 }
 
 bool Accel::occluded(const Ray& ray) const {
@@ -488,39 +496,31 @@ bool Accel::occluded(const Ray& ray) const {
 
 namespace {
 
-// Packets of 16 rays of one kind (intersect or shadow) in the order they come; the last packet
-// masks its unused lanes.
+// Packets of 16 rays of one kind (intersect or shadow) in the order they come.
 size_t cast_packets16(RTCScene scene, RTCIntersectContext& ctx, const Ray* rays, const uint8_t* shadow, size_t n) {
-  constexpr int W = 16;
   alignas(64) RTCRayHit16 hits16;
   alignas(64) RTCRay16 shadows16;
-  alignas(64) int valid[W];
   size_t hits = 0;
   for (int kind = 0; kind < 2; ++kind) {
     RTCRay16& r16 = kind ? shadows16 : hits16.ray;
-    int lanes = 0;
-    std::vector<size_t> lane_ray(W);
-    auto flush = [&] {
-      for (int k = 0; k < W; ++k) valid[k] = k < lanes ? -1 : 0;
-      for (int k = lanes; k < W; ++k) to_lane(rays[lane_ray[0]], r16, k);  // see to_lane
+    Lanes16 lanes;
+    auto trace = [&] {
+      lanes.seal(rays, r16);
       if (kind) {
-        rtcOccluded16(valid, scene, &ctx, &shadows16);
-        for (int k = 0; k < lanes; ++k) hits += shadows16.tfar[k] < 0;
+        rtcOccluded16(lanes.valid, scene, &ctx, &shadows16);
+        for (int k = 0; k < lanes.used; ++k) hits += shadows16.tfar[k] < 0;
       } else {
-        rtcIntersect16(valid, scene, &ctx, &hits16);
-        for (int k = 0; k < lanes; ++k) hits += hits16.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect16(lanes.valid, scene, &ctx, &hits16);
+        for (int k = 0; k < lanes.used; ++k) hits += hits16.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
       }
-      lanes = 0;
+      lanes.used = 0;
     };
     for (size_t i = 0; i < n; ++i) {
       if (shadow[i] != kind) continue;
-      const int k = lanes++;
-      to_lane(rays[i], r16, k);
-      lane_ray[size_t(k)] = i;
-      if (!kind) hits16.hit.geomID[k] = hits16.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-      if (lanes == W) flush();
+      if (!kind) hits16.hit.geomID[lanes.used] = hits16.hit.instID[0][lanes.used] = RTC_INVALID_GEOMETRY_ID;
+      if (lanes.add(rays, uint32_t(i), r16)) trace();
     }
-    if (lanes) flush();
+    if (lanes.used) trace();
   }
   return hits;
 }

@@ -110,12 +110,7 @@ TEST(Features, SpecialisedAndGenericLoopsRenderTheSameImage) {
     std::string p = test::shared_scene(f);
     if (!p.empty()) cases.push_back({p, ""});
   }
-  ImageRGB env;
-  env.width = 16;
-  env.height = 8;
-  env.pixels.assign(128, Vec3(0.3f, 0.4f, 0.6f));
-  std::string env_path = test::temp_dir() + "/features_sky.exr";
-  write_image(env, env_path);
+  std::string env_path = test::uniform_sky("features_sky.exr", Vec3(0.3f, 0.4f, 0.6f));
   cases.push_back({test::own_scene("dof.dae"), env_path});
   for (const Case& c : cases) {
     SCOPED_TRACE(c.path + " " + c.env);
@@ -146,12 +141,7 @@ TEST(Features, SpecialisedAndGenericLoopsRenderTheSameImage) {
 // job. Each view renders bit-identically to make_render_scene with the same options and seed.
 TEST(Features, ViewsOfASharedBaseRenderWhatMakeRenderSceneRenders) {
   SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
-  ImageRGB env;
-  env.width = 16;
-  env.height = 8;
-  env.pixels.assign(128, Vec3(0.2f, 0.3f, 0.5f));
-  std::string env_path = test::temp_dir() + "/features_shared_sky.exr";
-  write_image(env, env_path);
+  std::string env_path = test::uniform_sky("features_shared_sky.exr", Vec3(0.2f, 0.3f, 0.5f));
   auto base = std::make_shared<const SceneBase>(make_scene_base(desc));
   ASSERT_TRUE(base->accel);
   EXPECT_GE(base->memory_bytes(), base->accel->memory_bytes());

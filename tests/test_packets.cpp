@@ -61,12 +61,7 @@ size_t differing_pixels(const ImageRGB& a, const ImageRGB& b) {
 }  // namespace
 
 TEST(Packets, BatchedPathsRenderWhatThePathByPathLoopRenders) {
-  ImageRGB env;
-  env.width = 16;
-  env.height = 8;
-  env.pixels.assign(128, Vec3(0.3f, 0.4f, 0.6f));
-  std::string env_path = test::temp_dir() + "/packets_sky.exr";
-  write_image(env, env_path);
+  std::string env_path = test::uniform_sky("packets_sky.exr", Vec3(0.3f, 0.4f, 0.6f));
   std::vector<Case> all = cases();
   RenderParams sky = all[0].params;
   sky.env_map = env_path;  // escaping rays look the environment up (the infinite-light loop)

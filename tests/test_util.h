@@ -59,4 +59,15 @@ inline RegionStats region_stats(const ImageRGB& img, int x0, int y0, int x1, int
   return r;
 }
 
+// Writes a 16x8 environment map of one colour into the test temp dir and returns its path.
+inline std::string uniform_sky(const std::string& name, Vec3 colour) {
+  ImageRGB env;
+  env.width = 16;
+  env.height = 8;
+  env.pixels.assign(size_t(env.width) * env.height, colour);
+  std::string path = temp_dir() + "/" + name;
+  write_image(env, path);
+  return path;
+}
+
 }  // namespace pt::test
