@@ -9,7 +9,7 @@ runs=${1:-5}
 S=../shared/scenes-cs184
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-rate() { ./build/pathtracer -t 2 -s 64 -l 1 -m 5 -r 480 360 --no-adaptive -f "$out/v.exr" "$@" | tail -1 |
+rate() { ./build/pathtracer -t 2 -s 64 -l 1 -m 5 -r 480 360 --no-adaptive -f "$out/v.exr" "$@" 2>/dev/null | tail -1 |
          grep -o '[0-9.e+]* samples/s' | cut -d' ' -f1; }
 for s in CBspheres CBbunny CBdragon dof; do
   if [ "$s" = dof ]; then f=scenes/dof.dae; x=(-b 0.12 -d 4.7); else f=$S/$s.dae; x=(--keep-fov); fi
