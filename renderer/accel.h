@@ -46,7 +46,8 @@ class Accel {
   // The same queries for n rays at once, traced in Embree packets of 16 (bench_ceiling: 26-38%
   // more rays/s than one at a time on the course scenes). found[i] / blocked[i] are 1 or 0; hits[i]
   // is written where found[i]. Packet traversal may round a few hits differently from the
-  // single-ray kernel (about 5 in 100,000 in the last bit of t or u, v), never their number.
+  // single-ray kernel (5 in 100,000 random rays in the last bit of t, u, v or Ng; none of them
+  // turned a hit into a miss).
   void intersect_many(const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found) const;
   void occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const;
   // Bytes held for rendering: everything Embree allocated (BVH, vertex and index buffers, as its
