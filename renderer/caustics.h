@@ -6,9 +6,9 @@
 // "light tracing"), each such path reaches the camera by one connection. The two methods split
 // the paths between them, so their sum is unbiased:
 // - the path tracer drops emitter hits of area and mesh lights reached by one or more delta
-//   bounces straight after the first camera vertex when that vertex is not delta;
-// - the light tracer produces exactly those paths: it leaves an area or mesh light, follows delta
-//   bounces only, and at the first non-delta surface connects to the camera and stops.
+//   bounces after one or more non-delta vertices, the first camera vertex among them (E D+ S+ L);
+// - the light tracer produces exactly those paths: it leaves an area or mesh light, follows one or
+//   more delta bounces, and connects every non-delta vertex after them to the camera (L S+ D+ E).
 // Light paths are aimed at bounding spheres of the delta geometry (a directional pdf over the cones
 // they subtend), since every other direction starts a path the path tracer keeps.
 #pragma once
