@@ -4,6 +4,7 @@
 on this machine, in one run.
 
     python3 bench/vs_mitsuba.py [--scenes CBspheres,CBbunny] [--spp 64] [--runs 3] [--ref-spp 1024]
+                                [--ours=--no-caustic-tracing]
 
 Mitsuba comes from PyPI into build/mitsuba-venv (mitsuba 3.5.2: later Dr.Jit versions emit LLVM IR
 that needs LLVM 16 or newer, and Debian 12 ships 14 and 15; Dr.Jit finds Debian's libLLVM through
@@ -14,6 +15,9 @@ box pixel filter; Mitsuba's max_depth counts the emitter hit, so our -m M is its
 Each renderer's error is measured against its own high-spp reference (cached in build/bench-cache),
 and the two references are compared with each other to check that the conversion is faithful.
 Timings exclude start-up: Mitsuba's kernel compilation (one warm-up render) and our scene load.
+--ours adds flags to our timed runs only (the reference keeps the defaults): flags that change how
+we sample, not what converges, such as --no-caustic-tracing (unidirectional path tracing, as
+Mitsuba's `path` does) or --no-ray-packets.
 """
 import argparse
 import json
@@ -131,9 +135,9 @@ def mitsuba_scene(mi, folder, depth, spp, seed_unused=0):
     return mi.load_dict(scene)
 
 
-def run_ours(args, scene_path, depth, spp, out, seed):
+def run_ours(args, scene_path, depth, spp, out, seed, extra=()):
     cmd = [str(BUILD / "pathtracer"), "-t", "2", "-s", str(spp), "-l", "1", "-m", str(depth), "-r", "480", "360",
-           "--keep-fov", "--no-adaptive", "--quiet", "--seed", str(seed), "-f", str(out), str(scene_path)]
+           "--keep-fov", "--no-adaptive", "--quiet", "--seed", str(seed), *extra, "-f", str(out), str(scene_path)]
     if args.sampler:
         cmd[1:1] = ["--sampler", args.sampler]
     text = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
@@ -149,6 +153,7 @@ def main():
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--depth", type=int, default=0, help="our -m for every scene (default: 5)")
     ap.add_argument("--sampler", default="", help="our sampler (sobol, independent; default ours)")
+    ap.add_argument("--ours", default="", help="extra pathtracer flags for our timed runs, e.g. --ours=--no-caustic-tracing")
     args = ap.parse_args()
     if not SHARED.exists():
         print("vs_mitsuba: skipping: ../shared/scenes-cs184 is absent")
@@ -167,7 +172,8 @@ def main():
     cache.mkdir(parents=True, exist_ok=True)
     pixels = 480 * 360
     print(f"vs_mitsuba: 480x360 keep_fov, {args.spp} spp, 2 threads, medians of {args.runs}; references "
-          f"{args.ref_spp} spp; Mitsuba {mi.__version__} llvm_ad_rgb ({llvm})")
+          f"{args.ref_spp} spp; Mitsuba {mi.__version__} llvm_ad_rgb ({llvm})"
+          + (f"; ours with {args.ours}" if args.ours else ""))
     header = (f"{'scene':<10} {'renderer':<9} {'seconds':>8} {'M samples/s':>12} {'relMSE':>10} {'efficiency':>11}")
     rows = []
     for name in [s for s in args.scenes.split(",") if s]:
@@ -206,7 +212,7 @@ def main():
         out = cache / f"ours-{name}-run.exr"
         for k in range(args.runs):
             progress(f"{name}: ours", k, args.runs, started)
-            sec, rate = run_ours(args, SHARED / file, depth, args.spp, out, 100 + k)
+            sec, rate = run_ours(args, SHARED / file, depth, args.spp, out, 100 + k, args.ours.split())
             ot.append(sec)
             orate.append(rate)
             oe.append(rel_mse(np, np.array(mi.Bitmap(str(out))), oref))
