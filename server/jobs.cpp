@@ -131,7 +131,7 @@ bool parse_job_state(const std::string& s, JobState* out) {
   return false;
 }
 
-JobManager::JobManager(ManagerConfig config) : m_config(std::move(config)), m_scenes(m_config.scene_dirs) {}
+JobManager::JobManager(ManagerConfig config) : m_config(std::move(config)), m_scenes(m_config.scene_dirs, m_config.scene_cache_bytes) {}
 
 JobManager::~JobManager() { stop(); }
 

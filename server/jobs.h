@@ -63,6 +63,7 @@ struct Job {
 struct ManagerConfig {
   std::string data_dir = "data";
   std::vector<std::string> scene_dirs;
+  size_t scene_cache_bytes = SceneLibrary::kDefaultCacheBytes;  // built scenes kept for later jobs
   int threads = 1;          // render threads per job
   int concurrency = 1;      // jobs rendering at once
   size_t max_queue = 32;    // queued jobs; more is refused

@@ -25,6 +25,8 @@ const char* kUsage =
     "  --web DIR         the page to serve at / (default: the bundled web/)\n"
     "  --threads N       render threads per job (default: all cores)\n"
     "  --concurrency N   jobs rendering at once (default 1)\n"
+    "  --scene-cache-mb N  built scenes (BVH, lights) kept for later jobs, in MiB; past it the least\n"
+    "                    recently used one no job holds is dropped (default 1024)\n"
     "  --max-queue N     queued jobs before new ones are refused with 429 (default 32)\n"
     "  --queue URL       'embedded' (default: render here) or redis://HOST:PORT: hand sample passes\n"
     "                    to render-worker processes through Redis Streams (docs/scale-out.md)\n"
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
     else if (a == "--web") web = value();
     else if (a == "--threads") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.threads = int(n); }
     else if (a == "--concurrency") { const char* v = value(); if (!parse_int(v, 1, 64, &n)) bad(v); cfg.concurrency = int(n); }
+    else if (a == "--scene-cache-mb") { const char* v = value(); if (!parse_int(v, 0, 1 << 30, &n)) bad(v); cfg.scene_cache_bytes = size_t(n) << 20; }
     else if (a == "--max-queue") { const char* v = value(); if (!parse_int(v, 0, 100000, &n)) bad(v); cfg.max_queue = size_t(n); }
     else if (a == "--queue") cfg.queue = value();
     else if (a == "--units-in-flight") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.units_in_flight = int(n); }

@@ -44,7 +44,7 @@ json summarize(const pt::SceneDesc& d) {
 
 }  // namespace
 
-SceneLibrary::SceneLibrary(std::vector<std::string> dirs) {
+SceneLibrary::SceneLibrary(std::vector<std::string> dirs, size_t cache_bytes) : m_cache_bytes(cache_bytes) {
   for (const std::string& d : dirs) {
     std::string c = canonical(d);
     if (!c.empty()) m_dirs.push_back(c);
@@ -93,6 +93,29 @@ void SceneLibrary::forget_unused() {
   }
 }
 
+void SceneLibrary::evict_over_budget(uint64_t keep) {
+  // bytes > 0 only once the base's future holds it (set after set_value, reset on eviction).
+  auto built = [](const Entry& e) { return e.bytes > 0 && e.base.valid(); };
+  size_t total = 0;
+  for (const auto& kv : m_cache)
+    if (built(kv.second)) total += kv.second.bytes;
+  while (total > m_cache_bytes) {
+    Entry* oldest = nullptr;
+    for (auto& kv : m_cache) {
+      Entry& e = kv.second;
+      // use_count 1: only the cache holds the base (a running job's view holds another).
+      if (kv.first == keep || !built(e) || e.base.get().use_count() > 1) continue;
+      if (!oldest || e.used_at < oldest->used_at) oldest = &e;
+    }
+    if (!oldest) return;  // everything left is in use
+    total -= oldest->bytes;
+    std::fprintf(stderr, "render-server: scene '%s' dropped from the cache (%.2f MiB, unused; %.2f MiB kept, budget %.2f MiB)\n",
+                 oldest->name.c_str(), oldest->bytes / 1048576.0, total / 1048576.0, m_cache_bytes / 1048576.0);
+    oldest->base = {};
+    oldest->bytes = 0;
+  }
+}
+
 std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name) {
   uint64_t hash = 0;
   std::string bytes = read_scene(name, &hash);
@@ -107,28 +130,27 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
       e.base = promise.get_future().share();
       e.build_id = build_id = ++m_next_build;
     }
+    e.used_at = ++m_clock;
+    e.name = name;
     result = e.base;
     forget_unused();
+    evict_over_budget(hash);  // bases whose jobs have ended since the last build
   }
   if (build_id == 0) return result.get();  // rethrows the builder's error
   // Parse and build outside the lock: a big scene must not block status requests. Messages name
   // the scene, not the server's paths.
+  Base base;
+  json summary;
   try {
     auto t0 = std::chrono::steady_clock::now();
     pt::SceneDesc desc = pt::parse_collada(bytes, name + ".dae");
     std::string().swap(bytes);
-    json summary = summarize(desc);
-    auto base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(desc));
+    summary = summarize(desc);
+    base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(desc));
     desc = pt::SceneDesc();  // from here on only the base holds the scene
     double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::fprintf(stderr, "render-server: scene '%s' built in %.3f s (%zu triangles, %zu spheres, %.2f MiB), shared by its jobs\n",
                  name.c_str(), s, base->triangle_count, base->sphere_count, base->memory_bytes() / 1048576.0);
-    {
-      std::lock_guard<std::mutex> lock(m_mutex);
-      auto it = m_cache.find(hash);
-      if (it != m_cache.end()) it->second.summary = summary;
-    }
-    promise.set_value(base);
   } catch (...) {
     {  // not cached: the next request tries again
       std::lock_guard<std::mutex> lock(m_mutex);
@@ -136,8 +158,17 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
       if (it != m_cache.end() && it->second.build_id == build_id) it->second.base = {};
     }
     promise.set_exception(std::current_exception());
+    return result.get();  // rethrows
   }
-  return result.get();
+  promise.set_value(base);  // before its bytes count: the cache evicts only ready bases
+  std::lock_guard<std::mutex> lock(m_mutex);
+  auto it = m_cache.find(hash);
+  if (it != m_cache.end() && it->second.build_id == build_id) {
+    it->second.summary = summary;
+    it->second.bytes = std::max<size_t>(1, base->memory_bytes());
+  }
+  evict_over_budget(hash);
+  return base;
 }
 
 json SceneLibrary::list() {
@@ -158,7 +189,11 @@ json SceneLibrary::list() {
   for (const std::string& name : names) {
     json item{{"name", name}};
     try {
-      item["summary"] = summary(name);
+      uint64_t hash = 0;
+      item["summary"] = summary(name, &hash);
+      std::lock_guard<std::mutex> lock(m_mutex);
+      auto it = m_cache.find(hash);
+      if (it != m_cache.end() && it->second.bytes > 0) item["memory_bytes"] = it->second.bytes;
     } catch (const std::exception& e) {
       item["error"] = e.what();
     }
@@ -167,9 +202,10 @@ json SceneLibrary::list() {
   return out;
 }
 
-json SceneLibrary::summary(const std::string& name) {
+json SceneLibrary::summary(const std::string& name, uint64_t* content_hash) {
   uint64_t hash = 0;
   std::string bytes = read_scene(name, &hash);
+  if (content_hash) *content_hash = hash;
   json summary;
   {
     std::lock_guard<std::mutex> lock(m_mutex);

@@ -1,6 +1,8 @@
 // Scene files the server may render: names resolved only inside the configured directories
 // (no paths, no symlinks out); per distinct file content, one summary and one shared render-scene
 // base (BVH, lights, materials) that every job on it views. The file's vertex arrays are not kept.
+// Built bases stay cached for later jobs within a byte budget: past it, the least recently used
+// base no job holds is dropped (its summary stays) and is built again when a job next asks.
 #pragma once
 
 #include <cstdint>
@@ -18,7 +20,8 @@ namespace srv {
 
 class SceneLibrary {
  public:
-  explicit SceneLibrary(std::vector<std::string> dirs);
+  static constexpr size_t kDefaultCacheBytes = size_t(1) << 30;
+  explicit SceneLibrary(std::vector<std::string> dirs, size_t cache_bytes = kDefaultCacheBytes);
   // The file for a scene name, or "" when no configured directory holds it.
   std::string resolve(const std::string& name) const;
   // The scene's shared render base (a job makes its view with pt::make_view), built at most once
@@ -27,8 +30,10 @@ class SceneLibrary {
   std::shared_ptr<const pt::SceneBase> load(const std::string& name);
   // A scene's summary (counts, materials, lights, the course camera's focus distance); parses a
   // file it has not seen but builds nothing, so it also validates cheaply. Throws as load() does.
-  json summary(const std::string& name);
-  // Every scene with its summary, or its load error.
+  // `content_hash`, when given, receives the hash of the file's content the summary is of.
+  json summary(const std::string& name, uint64_t* content_hash = nullptr);
+  // Every scene with its summary, or its load error, and the bytes of its built base while the
+  // cache holds one.
   json list();
 
  private:
@@ -37,16 +42,24 @@ class SceneLibrary {
     json summary;                   // null until the content was parsed once
     std::shared_future<Base> base;  // valid once a build started; ready when it ended
     uint64_t build_id = 0;          // which load() is building it
+    size_t bytes = 0;               // the built base's memory_bytes(); 0 until built
+    uint64_t used_at = 0;           // m_clock at its last load(): the least recent goes first
+    std::string name;               // the last name it was loaded under, for the log
   };
   // The file's bytes and their FNV-1a hash; throws as load() does.
   std::string read_scene(const std::string& name, uint64_t* hash) const;
   void forget_unused();  // with m_mutex held
+  // Drops the least recently used built bases that no job holds while the cached bytes exceed the
+  // budget; never `keep`. With m_mutex held.
+  void evict_over_budget(uint64_t keep);
 
   std::vector<std::string> m_dirs;  // canonical
+  size_t m_cache_bytes;
   std::mutex m_mutex;
   std::map<uint64_t, Entry> m_cache;            // by content hash
   std::map<std::string, uint64_t> m_last_hash;  // scene name -> hash of its last loaded content
   uint64_t m_next_build = 0;
+  uint64_t m_clock = 0;
 };
 
 }  // namespace srv
