@@ -1,6 +1,6 @@
-// The GLFW debug window: a render thread runs RenderSession passes of doubling sample targets
-// and hands finished tiles (tone-mapped exactly like the PNG) to the window thread, which
-// uploads them into one texture drawn as a full-window quad (OpenGL 1.x/2.1 calls only, so
+// The GLFW debug window: a render thread (viewer_loop.h) runs RenderSession passes of doubling
+// sample targets and hands finished tiles (tone-mapped exactly like the PNG) to the window thread,
+// which uploads them into one texture drawn as a full-window quad (OpenGL 1.x/2.1 calls only, so
 // Mesa's llvmpipe under Xvfb runs it). Keys change RenderParams, cancel the running pass through
 // its cancel flag and start a new session; the window thread never waits on rendering.
 // The render size follows the window's framebuffer (course behaviour); until the new session's
@@ -10,14 +10,9 @@
 
 #include <GLFW/glfw3.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdarg>
-#include <condition_variable>
 #include <cstdio>
-#include <ctime>
-#include <deque>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -26,239 +21,13 @@
 
 #include "collada.h"
 #include "render.h"
+#include "viewer_loop.h"
 
 namespace pt {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
-
-void say(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-void say(const char* fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  std::vfprintf(stdout, fmt, ap);
-  va_end(ap);
-  std::fputc('\n', stdout);
-  std::fflush(stdout);
-}
-
-std::string fmt_g(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-// The scene path without ".dae": the course names screenshots and camera files after it.
-std::string scene_base(const std::string& path) {
-  if (path.size() > 4 && path.compare(path.size() - 4, 4, ".dae") == 0) return path.substr(0, path.size() - 4);
-  return path;
-}
-
-// ---- state shared by the window thread and the render thread ----
-
-struct TileUpdate {
-  uint64_t gen;
-  Tile tile;
-  std::vector<uint8_t> rgb, rate;  // tone-mapped radiance and the rate colouring, 3 bytes a pixel
-};
-
-// What the render thread reports about the session it runs.
-struct Status {
-  uint64_t gen = 0;  // 0: no session yet
-  int width = 0, height = 0;
-  int spp = 0;           // the session's target
-  int reached_spp = 0;   // the last completed pass's target
-  bool finished = false;
-  double error = INFINITY, seconds = 0;
-};
-
-enum class CommandKind { focus, save };
-
-struct Command {
-  CommandKind kind;
-  float sx = 0, sy = 0;  // focus: sensor point, y up
-};
-
-struct Shared {
-  std::mutex mutex;
-  std::condition_variable wake;
-  RenderParams want;       // what the window asks for; a change bumps want_gen
-  uint64_t want_gen = 1;
-  std::deque<Command> commands;
-  uint64_t issued = 0, handled = 0;  // commands
-  bool quit = false;
-  std::string fatal;       // a render-thread error that ends the window
-  std::atomic<bool> cancel{false};
-  Status status;
-
-  std::mutex tile_mutex;
-  std::vector<TileUpdate> tiles;
-};
-
-// ---- the render thread ----
-
-class RenderLoop {
- public:
-  RenderLoop(const CliOptions& o, const SceneDesc& desc, RenderScene& scene, Shared& sh)
-      : m_options(o), m_desc(desc), m_scene(scene), m_sh(sh) {}
-
-  void run() {
-    try {
-      loop();
-    } catch (const std::exception& e) {
-      std::lock_guard<std::mutex> lk(m_sh.mutex);
-      m_sh.fatal = e.what();
-    }
-    glfwPostEmptyEvent();
-  }
-
- private:
-  void loop() {
-    std::unique_lock<std::mutex> lk(m_sh.mutex);
-    for (;;) {
-      if (m_sh.quit) return;
-      if (!m_sh.commands.empty()) {
-        Command c = m_sh.commands.front();
-        m_sh.commands.pop_front();
-        RenderParams want = m_sh.want;
-        lk.unlock();
-        float focus = handle(c, want);
-        lk.lock();
-        if (c.kind == CommandKind::focus && std::isfinite(focus)) {
-          m_sh.want.focal_distance = focus;
-          ++m_sh.want_gen;
-        }
-        ++m_sh.handled;
-        glfwPostEmptyEvent();
-        continue;
-      }
-      if (!m_session || m_gen != m_sh.want_gen) {
-        RenderParams p = m_sh.want;
-        uint64_t gen = m_sh.want_gen;
-        lk.unlock();
-        start_session(p, gen);
-        lk.lock();
-        continue;
-      }
-      if (m_done) {
-        m_sh.wake.wait(lk);
-        continue;
-      }
-      // Every request is consumed above with the lock held; one made after this line cancels the pass.
-      m_sh.cancel = false;
-      lk.unlock();
-      uint64_t gen = m_gen;
-      RenderSession* s = m_session.get();
-      bool ok = s->render_pass(m_target, &m_sh.cancel, [this, gen, s](const Tile& t) { send_tile(gen, *s, t); });
-      if (ok) {
-        Status st = m_status;
-        st.reached_spp = m_target;
-        st.finished = m_target >= m_params.spp || s->finished();
-        st.error = s->error_estimate();
-        st.seconds = s->stats().seconds;
-        m_status = st;
-        m_done = st.finished;
-        if (!m_options.quiet)
-          say("pass: %d/%d spp, error estimate %.3g, %.2f s", st.reached_spp, st.spp, st.error, st.seconds);
-        m_target = std::min(m_params.spp, m_target * 2);
-      }
-      lk.lock();
-      if (ok) m_sh.status = m_status;
-      glfwPostEmptyEvent();
-    }
-  }
-
-  void start_session(const RenderParams& p, uint64_t gen) {
-    m_session.reset();
-    m_scene.camera = make_camera(m_desc, camera_params(p));
-    m_session = std::make_unique<RenderSession>(m_scene, p);
-    m_params = p;
-    m_gen = gen;
-    m_target = 1;
-    m_done = false;
-    m_status = Status{};
-    m_status.gen = gen;
-    m_status.width = m_session->width();
-    m_status.height = m_session->height();
-    m_status.spp = p.spp;
-    std::lock_guard<std::mutex> lk(m_sh.mutex);
-    m_sh.status = m_status;
-  }
-
-  // Runs on a worker thread right after the tile is finished for this pass.
-  void send_tile(uint64_t gen, const RenderSession& s, const Tile& t) {
-    TileUpdate u{gen, t, {}, {}};
-    std::vector<Vec3> px;
-    s.read_tile(t, px);
-    u.rgb.resize(px.size() * 3);
-    for (size_t i = 0; i < px.size(); ++i)
-      for (int c = 0; c < 3; ++c) u.rgb[3 * i + c] = tonemap_course(px[i][c]);
-    s.read_tile_rate(t, px);
-    u.rate.resize(px.size() * 3);
-    for (size_t i = 0; i < px.size(); ++i)
-      for (int c = 0; c < 3; ++c) u.rate[3 * i + c] = tonemap_course(px[i][c]);  // as the _rate.png
-    bool was_empty;
-    {
-      std::lock_guard<std::mutex> lk(m_sh.tile_mutex);
-      was_empty = m_sh.tiles.empty();
-      m_sh.tiles.push_back(std::move(u));
-    }
-    if (was_empty) glfwPostEmptyEvent();
-  }
-
-  // Runs between passes (the pass was cancelled to get here; it resumes where it stopped).
-  // Returns the autofocus distance for a focus command.
-  float handle(const Command& c, const RenderParams& want) {
-    if (c.kind == CommandKind::focus) {
-      // The pinhole ray of the camera the window shows now (pose and size; lens settings do not matter).
-      Camera current = m_scene.camera;
-      m_scene.camera = make_camera(m_desc, camera_params(want));
-      float d = autofocus_distance(m_scene, c.sx, c.sy);
-      m_scene.camera = current;
-      if (std::isfinite(d))
-        say("autofocus (%.4f, %.4f): focal distance %s", c.sx, c.sy, fmt_g(d).c_str());
-      else
-        say("autofocus (%.4f, %.4f): nothing under the cursor, focal distance unchanged", c.sx, c.sy);
-      return d;
-    }
-    if (!m_session) {
-      say("save: nothing rendered yet");
-      return 0;
-    }
-    std::time_t now = std::time(nullptr);
-    std::tm lt{};
-    localtime_r(&now, &lt);
-    char stamp[64];
-    std::snprintf(stamp, sizeof stamp, "_screenshot_%d-%d_%d-%d-%d", lt.tm_mon + 1, lt.tm_mday, lt.tm_hour, lt.tm_min,
-                  lt.tm_sec);
-    std::string base = scene_base(m_options.scene_path) + stamp;
-    CliOptions o = m_options;
-    o.params = m_params;
-    try {
-      write_image(m_session->image(), base + ".png");
-      write_image(m_session->image(), base + ".exr", render_metadata(o, *m_session));
-      write_image(m_session->rate_image(), rate_image_path(base + ".png"));
-      say("saved %s.png, %s.exr, %s", base.c_str(), base.c_str(), rate_image_path(base + ".png").c_str());
-    } catch (const std::exception& e) {
-      say("save failed: %s", e.what());
-    }
-    return 0;
-  }
-
-  const CliOptions& m_options;
-  const SceneDesc& m_desc;
-  RenderScene& m_scene;  // its camera is rebuilt for each session; only this thread touches it
-  Shared& m_sh;
-  std::unique_ptr<RenderSession> m_session;
-  RenderParams m_params;
-  uint64_t m_gen = 0;
-  int m_target = 1;
-  bool m_done = false;
-  Status m_status;
-};
+using namespace viewer;
 
 // ---- the script player ----
 
@@ -357,6 +126,7 @@ class Viewer {
     say("window: %dx%d, %s", m_sh.want.width, m_sh.want.height, settings_text(m_sh.want).c_str());
 
     glGenTextures(1, &m_tex);
+    m_sh.wake_window = [] { glfwPostEmptyEvent(); };
     RenderLoop loop(m_options, m_desc, *scene, m_sh);
     std::thread render([&] { loop.run(); });
     while (!glfwWindowShouldClose(m_win)) {

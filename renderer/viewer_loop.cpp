@@ -1,0 +1,174 @@
+// The debug window's render thread (viewer_loop.h).
+#include "viewer_loop.h"
+
+#include <cstdarg>
+#include <cstdio>
+#include <ctime>
+#include <sstream>
+
+#include "collada.h"
+
+namespace pt {
+namespace viewer {
+
+void say(const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  std::vfprintf(stdout, fmt, ap);
+  va_end(ap);
+  std::fputc('\n', stdout);
+  std::fflush(stdout);
+}
+
+std::string fmt_g(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+std::string scene_base(const std::string& path) {
+  if (path.size() > 4 && path.compare(path.size() - 4, 4, ".dae") == 0) return path.substr(0, path.size() - 4);
+  return path;
+}
+
+void RenderLoop::run() {
+  try {
+    loop();
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lk(m_sh.mutex);
+    m_sh.fatal = e.what();
+  }
+  m_sh.wake_window();
+}
+
+void RenderLoop::loop() {
+  std::unique_lock<std::mutex> lk(m_sh.mutex);
+  for (;;) {
+    if (m_sh.quit) return;
+    if (!m_sh.commands.empty()) {
+      Command c = m_sh.commands.front();
+      m_sh.commands.pop_front();
+      RenderParams want = m_sh.want;
+      lk.unlock();
+      float focus = handle(c, want);
+      lk.lock();
+      if (c.kind == CommandKind::focus && std::isfinite(focus)) {
+        m_sh.want.focal_distance = focus;
+        ++m_sh.want_gen;
+      }
+      ++m_sh.handled;
+      m_sh.wake_window();
+      continue;
+    }
+    if (!m_session || m_gen != m_sh.want_gen) {
+      RenderParams p = m_sh.want;
+      uint64_t gen = m_sh.want_gen;
+      lk.unlock();
+      start_session(p, gen);
+      lk.lock();
+      continue;
+    }
+    if (m_done) {
+      m_sh.wake.wait(lk);
+      continue;
+    }
+    // Every request is consumed above with the lock held; one made after this line cancels the pass.
+    m_sh.cancel = false;
+    lk.unlock();
+    uint64_t gen = m_gen;
+    RenderSession* s = m_session.get();
+    bool ok = s->render_pass(m_target, &m_sh.cancel, [this, gen, s](const Tile& t) { send_tile(gen, *s, t); });
+    if (ok) {
+      Status st = m_status;
+      st.reached_spp = m_target;
+      st.finished = m_target >= m_params.spp || s->finished();
+      st.error = s->error_estimate();
+      st.seconds = s->stats().seconds;
+      m_status = st;
+      m_done = st.finished;
+      if (!m_options.quiet)
+        say("pass: %d/%d spp, error estimate %.3g, %.2f s", st.reached_spp, st.spp, st.error, st.seconds);
+      m_target = std::min(m_params.spp, m_target * 2);
+    }
+    lk.lock();
+    if (ok) m_sh.status = m_status;
+    m_sh.wake_window();
+  }
+}
+
+void RenderLoop::start_session(const RenderParams& p, uint64_t gen) {
+  m_session.reset();
+  m_scene.camera = make_camera(m_desc, camera_params(p));
+  m_session = std::make_unique<RenderSession>(m_scene, p);
+  m_params = p;
+  m_gen = gen;
+  m_target = 1;
+  m_done = false;
+  m_status = Status{};
+  m_status.gen = gen;
+  m_status.width = m_session->width();
+  m_status.height = m_session->height();
+  m_status.spp = p.spp;
+  std::lock_guard<std::mutex> lk(m_sh.mutex);
+  m_sh.status = m_status;
+}
+
+void RenderLoop::send_tile(uint64_t gen, const RenderSession& s, const Tile& t) {
+  TileUpdate u{gen, t, {}, {}};
+  std::vector<Vec3> px;
+  s.read_tile(t, px);
+  u.rgb.resize(px.size() * 3);
+  for (size_t i = 0; i < px.size(); ++i)
+    for (int c = 0; c < 3; ++c) u.rgb[3 * i + c] = tonemap_course(px[i][c]);
+  s.read_tile_rate(t, px);
+  u.rate.resize(px.size() * 3);
+  for (size_t i = 0; i < px.size(); ++i)
+    for (int c = 0; c < 3; ++c) u.rate[3 * i + c] = tonemap_course(px[i][c]);  // as the _rate.png
+  bool was_empty;
+  {
+    std::lock_guard<std::mutex> lk(m_sh.tile_mutex);
+    was_empty = m_sh.tiles.empty();
+    m_sh.tiles.push_back(std::move(u));
+  }
+  if (was_empty) m_sh.wake_window();
+}
+
+float RenderLoop::handle(const Command& c, const RenderParams& want) {
+  if (c.kind == CommandKind::focus) {
+    // The pinhole ray of the camera the window shows now (pose and size; lens settings do not matter).
+    Camera current = m_scene.camera;
+    m_scene.camera = make_camera(m_desc, camera_params(want));
+    float d = autofocus_distance(m_scene, c.sx, c.sy);
+    m_scene.camera = current;
+    if (std::isfinite(d))
+      say("autofocus (%.4f, %.4f): focal distance %s", c.sx, c.sy, fmt_g(d).c_str());
+    else
+      say("autofocus (%.4f, %.4f): nothing under the cursor, focal distance unchanged", c.sx, c.sy);
+    return d;
+  }
+  if (!m_session) {
+    say("save: nothing rendered yet");
+    return 0;
+  }
+  std::time_t now = std::time(nullptr);
+  std::tm lt{};
+  localtime_r(&now, &lt);
+  char stamp[64];
+  std::snprintf(stamp, sizeof stamp, "_screenshot_%d-%d_%d-%d-%d", lt.tm_mon + 1, lt.tm_mday, lt.tm_hour, lt.tm_min,
+                lt.tm_sec);
+  std::string base = scene_base(m_options.scene_path) + stamp;
+  CliOptions o = m_options;
+  o.params = m_params;
+  try {
+    write_image(m_session->image(), base + ".png");
+    write_image(m_session->image(), base + ".exr", render_metadata(o, *m_session));
+    write_image(m_session->rate_image(), rate_image_path(base + ".png"));
+    say("saved %s.png, %s.exr, %s", base.c_str(), base.c_str(), rate_image_path(base + ".png").c_str());
+  } catch (const std::exception& e) {
+    say("save failed: %s", e.what());
+  }
+  return 0;
+}
+
+}  // namespace viewer
+}  // namespace pt

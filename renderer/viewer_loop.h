@@ -1,0 +1,109 @@
+// The debug window's render thread (viewer.cpp runs the window): it runs RenderSession passes of
+// doubling sample targets for the settings the window asks for, hands finished tiles (tone-mapped
+// as the PNG is) to the window thread, and runs its focus and save commands between passes. No
+// GLFW here: it wakes the window through Shared::wake_window.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "render.h"
+
+namespace pt {
+namespace viewer {
+
+using Clock = std::chrono::steady_clock;
+inline double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+// A line on stdout, flushed: the window's log, which the tests read.
+void say(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+// A number as the course prints it (shortest %g).
+std::string fmt_g(double v);
+// The scene path without ".dae": the course names screenshots and camera files after it.
+std::string scene_base(const std::string& path);
+
+// ---- state shared by the window thread and the render thread ----
+
+struct TileUpdate {
+  uint64_t gen;
+  Tile tile;
+  std::vector<uint8_t> rgb, rate;  // tone-mapped radiance and the rate colouring, 3 bytes a pixel
+};
+
+// What the render thread reports about the session it runs.
+struct Status {
+  uint64_t gen = 0;  // 0: no session yet
+  int width = 0, height = 0;
+  int spp = 0;           // the session's target
+  int reached_spp = 0;   // the last completed pass's target
+  bool finished = false;
+  double error = INFINITY, seconds = 0;
+};
+
+enum class CommandKind { focus, save };
+
+struct Command {
+  CommandKind kind;
+  float sx = 0, sy = 0;  // focus: sensor point, y up
+};
+
+struct Shared {
+  std::mutex mutex;
+  std::condition_variable wake;
+  RenderParams want;       // what the window asks for; a change bumps want_gen
+  uint64_t want_gen = 1;
+  std::deque<Command> commands;
+  uint64_t issued = 0, handled = 0;  // commands
+  bool quit = false;
+  std::string fatal;       // a render-thread error that ends the window
+  std::atomic<bool> cancel{false};
+  Status status;
+
+  std::mutex tile_mutex;
+  std::vector<TileUpdate> tiles;
+
+  std::function<void()> wake_window;  // wakes the window thread's event wait (set before the loop runs)
+};
+
+// ---- the render thread ----
+
+class RenderLoop {
+ public:
+  RenderLoop(const CliOptions& o, const SceneDesc& desc, RenderScene& scene, Shared& sh)
+      : m_options(o), m_desc(desc), m_scene(scene), m_sh(sh) {}
+  // Renders until Shared::quit; an exception ends it with Shared::fatal set.
+  void run();
+
+ private:
+  void loop();
+  void start_session(const RenderParams& p, uint64_t gen);
+  // Runs on a worker thread right after the tile is finished for this pass.
+  void send_tile(uint64_t gen, const RenderSession& s, const Tile& t);
+  // Runs between passes (the pass was cancelled to get here; it resumes where it stopped).
+  // Returns the autofocus distance for a focus command.
+  float handle(const Command& c, const RenderParams& want);
+
+  const CliOptions& m_options;
+  const SceneDesc& m_desc;
+  RenderScene& m_scene;  // its camera is rebuilt for each session; only this thread touches it
+  Shared& m_sh;
+  std::unique_ptr<RenderSession> m_session;
+  RenderParams m_params;
+  uint64_t m_gen = 0;
+  int m_target = 1;
+  bool m_done = false;
+  Status m_status;
+};
+
+}  // namespace viewer
+}  // namespace pt
