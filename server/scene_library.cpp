@@ -93,7 +93,7 @@ void SceneLibrary::forget_unused() {
   }
 }
 
-void SceneLibrary::evict_over_budget(uint64_t keep) {
+void SceneLibrary::evict_over_budget(uint64_t keep, std::vector<std::shared_future<Base>>& dropped) {
   // bytes > 0 only once the base's future holds it (set after set_value, reset on eviction).
   auto built = [](const Entry& e) { return e.bytes > 0 && e.base.valid(); };
   size_t total = 0;
@@ -111,7 +111,7 @@ void SceneLibrary::evict_over_budget(uint64_t keep) {
     total -= oldest->bytes;
     std::fprintf(stderr, "render-server: scene '%s' dropped from the cache (%.2f MiB, unused; %.2f MiB kept, budget %.2f MiB)\n",
                  oldest->name.c_str(), oldest->bytes / 1048576.0, total / 1048576.0, m_cache_bytes / 1048576.0);
-    oldest->base = {};
+    dropped.push_back(std::move(oldest->base));  // leaves oldest->base invalid: rebuilt when asked
     oldest->bytes = 0;
   }
 }
@@ -122,6 +122,7 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
   std::promise<Base> promise;
   std::shared_future<Base> result;
   uint64_t build_id = 0;
+  std::vector<std::shared_future<Base>> dropped;  // freed after the lock: a big BVH takes a while
   {
     std::lock_guard<std::mutex> lock(m_mutex);
     m_last_hash[name] = hash;
@@ -134,8 +135,9 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
     e.name = name;
     result = e.base;
     forget_unused();
-    evict_over_budget(hash);  // bases whose jobs have ended since the last build
+    evict_over_budget(hash, dropped);  // bases whose jobs have ended since the last build
   }
+  dropped.clear();
   if (build_id == 0) return result.get();  // rethrows the builder's error
   // Parse and build outside the lock: a big scene must not block status requests. Messages name
   // the scene, not the server's paths.
@@ -161,13 +163,15 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
     return result.get();  // rethrows
   }
   promise.set_value(base);  // before its bytes count: the cache evicts only ready bases
-  std::lock_guard<std::mutex> lock(m_mutex);
-  auto it = m_cache.find(hash);
-  if (it != m_cache.end() && it->second.build_id == build_id) {
-    it->second.summary = summary;
-    it->second.bytes = std::max<size_t>(1, base->memory_bytes());
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    auto it = m_cache.find(hash);
+    if (it != m_cache.end() && it->second.build_id == build_id) {
+      it->second.summary = summary;
+      it->second.bytes = std::max<size_t>(1, base->memory_bytes());
+    }
+    evict_over_budget(hash, dropped);
   }
-  evict_over_budget(hash);
   return base;
 }
 

@@ -50,8 +50,9 @@ class SceneLibrary {
   std::string read_scene(const std::string& name, uint64_t* hash) const;
   void forget_unused();  // with m_mutex held
   // Drops the least recently used built bases that no job holds while the cached bytes exceed the
-  // budget; never `keep`. With m_mutex held.
-  void evict_over_budget(uint64_t keep);
+  // budget; never `keep`. With m_mutex held; the dropped bases go to `dropped`, for the caller to
+  // free once it has released the lock.
+  void evict_over_budget(uint64_t keep, std::vector<std::shared_future<Base>>& dropped);
 
   std::vector<std::string> m_dirs;  // canonical
   size_t m_cache_bytes;
