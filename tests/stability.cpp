@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bsdf_util.h"
 #include "cli.h"
 #include "collada.h"
 #include "render.h"
@@ -159,22 +160,9 @@ std::string env_file(const std::string& name, std::function<Vec3(int, int)> texe
   return path;
 }
 
+using bsdf_test::conductor;
 Material glass(float ior, Vec3 r = Vec3(1.0f), Vec3 t = Vec3(1.0f)) {
-  Material m;
-  m.type = MaterialType::glass;
-  m.ior = ior;
-  m.albedo = r;
-  m.transmittance = t;
-  return m;
-}
-
-Material conductor(float alpha, Vec3 eta, Vec3 k) {
-  Material m;
-  m.type = MaterialType::microfacet;
-  m.alpha = alpha;
-  m.eta = eta;
-  m.k = k;
-  return m;
+  return bsdf_test::dielectric(MaterialType::glass, ior, r, t);
 }
 
 // The sphere's pixels under a uniform white environment: mean and whether it stays <= 1 (no
