@@ -100,23 +100,32 @@ inline Vec3 offset_ray_origin(Vec3 p, Vec3 n) {
 }
 
 // A ray leaving the surface in direction d, origin pushed off to the side d points to.
-inline Ray spawn_ray(const SurfaceHit& hit, Vec3 d) {
+// Rays that go into arrays are written in place (the out-parameter forms): a returned Ray is
+// built with narrow stores and copied with wide loads, which cannot take their data from those
+// stores and wait until they retire (docs/performance.md, "store forwarding").
+inline void spawn_ray(const SurfaceHit& hit, Vec3 d, Ray& r) {
   Vec3 n = dot(d, hit.ng) >= 0 ? hit.ng : -hit.ng;
-  Ray r;
   r.o = offset_ray_origin(hit.p + n * hit.offset, n);
   r.d = d;
   r.tmin = 0;
   r.tmax = kInf;
+}
+inline Ray spawn_ray(const SurfaceHit& hit, Vec3 d) {
+  Ray r;
+  spawn_ray(hit, d, r);
   return r;
 }
 // A shadow ray from the surface to a point on another surface (target excluded).
-inline Ray spawn_ray_to(const SurfaceHit& hit, Vec3 target) {
+inline void spawn_ray_to(const SurfaceHit& hit, Vec3 target, Ray& r) {
   Vec3 n = dot(target - hit.p, hit.ng) >= 0 ? hit.ng : -hit.ng;
-  Ray r;
   r.o = offset_ray_origin(hit.p + n * hit.offset, n);
   r.d = target - r.o;
   r.tmin = 0;
   r.tmax = 1 - 1e-4f;  // stop short of the target surface itself
+}
+inline Ray spawn_ray_to(const SurfaceHit& hit, Vec3 target) {
+  Ray r;
+  spawn_ray_to(hit, target, r);
   return r;
 }
 

@@ -123,18 +123,22 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
   return c;
 }
 
-Ray Camera::pinhole_ray(float sx, float sy) const {
+void Camera::pinhole_ray(float sx, float sy, Ray& r) const {
   Vec3 dc((2 * sx - 1) * tan_half_w, (2 * sy - 1) * tan_half_h, -1);
-  Ray r;
   r.o = position;
   r.d = normalize(right * dc.x + up * dc.y + back * dc.z);
   r.tmin = tmin;
   r.tmax = tmax;
+}
+
+Ray Camera::pinhole_ray(float sx, float sy) const {
+  Ray r;
+  pinhole_ray(sx, sy, r);
   return r;
 }
 
-Ray Camera::generate_ray(float sx, float sy, Vec2 lens_u) const {
-  if (lens_radius <= 0) return pinhole_ray(sx, sy);
+void Camera::generate_ray(float sx, float sy, Vec2 lens_u, Ray& r) const {
+  if (lens_radius <= 0) return pinhole_ray(sx, sy, r);
   // Thin lens: lens disk at z = 0, plane of focus at z = -focal_distance (camera space).
   Vec3 dc((2 * sx - 1) * tan_half_w, (2 * sy - 1) * tan_half_h, -1);
   Vec3 focus = dc * focal_distance;
@@ -142,11 +146,15 @@ Ray Camera::generate_ray(float sx, float sy, Vec2 lens_u) const {
   Vec3 lens(lens_radius * d.x, lens_radius * d.y, 0);
   Vec3 dir = focus - lens;
   if (!(length_squared(dir) > 0)) dir = dc;  // focal distance 0 at the lens centre: no direction left
-  Ray r;
   r.o = position + right * lens.x + up * lens.y;
   r.d = normalize(right * dir.x + up * dir.y + back * dir.z);
   r.tmin = tmin;
   r.tmax = tmax;
+}
+
+Ray Camera::generate_ray(float sx, float sy, Vec2 lens_u) const {
+  Ray r;
+  generate_ray(sx, sy, lens_u, r);
   return r;
 }
 

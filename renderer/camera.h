@@ -30,8 +30,11 @@ struct Camera {
 
   // (sx, sy) in [0,1]^2 on the sensor, y up, (0,0) = bottom-left; lens_u picks the lens point.
   Ray generate_ray(float sx, float sy, Vec2 lens_u) const;
+  // The same, written into r (for rays that go into an array: see spawn_ray in accel.h).
+  void generate_ray(float sx, float sy, Vec2 lens_u, Ray& r) const;
   // The pinhole ray through the same sensor point (what autofocus casts).
   Ray pinhole_ray(float sx, float sy) const;
+  void pinhole_ray(float sx, float sy, Ray& r) const;
   // The inverse of generate_ray: the sensor point (sx, sy) whose ray from lens sample lens_u passes
   // through world point p, and that ray's origin. False for a point not in front of the lens or a
   // lens focused at zero. (sx, sy) may lie outside [0,1]^2.

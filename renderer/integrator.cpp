@@ -58,9 +58,15 @@ int samples_for(const Light& light, const RenderParams& params) {
   return light.is_delta() ? 1 : params.light_samples;
 }
 
+// The shadow ray of a light sample, written into r.
+inline void shadow_ray(const SurfaceHit& hit, const LightSample& ls, Ray& r) {
+  if (ls.infinite) spawn_ray(hit, ls.wi, r);
+  else spawn_ray_to(hit, ls.point, r);
+}
+
 // Light sampling at a non-delta vertex, every light, MIS-weighted against BSDF sampling. Each
-// sample that needs a shadow ray hands it to `shadow(ray, contribution)`, which adds the
-// contribution to the vertex's sum unless the ray is blocked (at once, or after a batch of them).
+// sample that needs a shadow ray hands it to `shadow(hit, sample, contribution)`, which adds the
+// contribution to the vertex's sum unless its shadow_ray is blocked (at once, or after a batch).
 template <uint32_t F, class ShadowSink>
 void direct_light_sampling(const RenderScene& scene, const RenderParams& params, const Vertex& v, Sampler& rng,
                            uint64_t& rays, ShadowSink&& shadow) {
@@ -76,8 +82,7 @@ void direct_light_sampling(const RenderScene& scene, const RenderParams& params,
       if (is_black(f) || is_black(ls.radiance)) continue;
       ++rays;
       float w = light.is_delta() ? 1.0f : power_heuristic(n * ls.pdf, pdf_f<F>(v.material, v.wo, wi));
-      shadow(ls.infinite ? spawn_ray(v.hit, ls.wi) : spawn_ray_to(v.hit, ls.point),
-             f * ls.radiance * (std::fabs(wi.z) * w / (ls.pdf * n)));
+      shadow(v.hit, ls, f * ls.radiance * (std::fabs(wi.z) * w / (ls.pdf * n)));
     }
   }
 }
@@ -223,7 +228,7 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
     if (rng.next_float() >= q) return false;
     st.beta /= q;
   }
-  st.ray = spawn_ray(hit, wi_world);
+  spawn_ray(hit, wi_world, st.ray);
   return true;
 }
 
@@ -231,7 +236,9 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
 template <uint32_t F>
 Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray, Sampler& rng, uint64_t& rays) {
   PathState st(ray, params.max_depth);
-  auto shadow = [&](const Ray& r, Vec3 contribution) {
+  auto shadow = [&](const SurfaceHit& hit, const LightSample& ls, Vec3 contribution) {
+    Ray r;
+    shadow_ray(hit, ls, r);
     if (!scene.accel->occluded(r)) st.direct_sum += contribution;
   };
   for (;;) {
@@ -254,6 +261,7 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   struct Slot {
     PathState st;
     uint32_t job;
+    Slot(const Ray& camera_ray, int max_depth, uint32_t job) : st(camera_ray, max_depth), job(job) {}
   };
   struct Shadow {
     uint32_t slot;
@@ -268,7 +276,7 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   size_t next = 0;
   for (;;) {
     while (slots.size() < kSlots && next < n) {
-      slots.push_back({PathState(camera_rays[next], params.max_depth), uint32_t(next)});
+      slots.emplace_back(camera_rays[next], params.max_depth, uint32_t(next));
       ++next;
     }
     if (slots.empty()) return;
@@ -279,9 +287,11 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
     shadow_rays.clear();
     shadows.clear();
     for (size_t i = 0; i < m; ++i) {
-      auto shadow = [&](const Ray& r, Vec3 contribution) {
-        shadow_rays.push_back(r);
-        shadows.push_back({uint32_t(i), contribution});
+      auto shadow = [&](const SurfaceHit& hit, const LightSample& ls, Vec3 contribution) {
+        shadow_ray(hit, ls, shadow_rays.emplace_back());  // in place: see spawn_ray
+        Shadow& s = shadows.emplace_back();
+        s.slot = uint32_t(i);
+        s.contribution = contribution;
       };
       alive[i] = path_step<F>(scene, params, slots[i].st, found[i] != 0, hits[i], rngs[slots[i].job], rays, shadow);
     }

@@ -6,12 +6,12 @@
 
 namespace pt {
 
-Ray RenderSession::camera_ray(int fx, int fy_up, Sampler& rng) const {
+void RenderSession::camera_ray(int fx, int fy_up, Sampler& rng, Ray& r) const {
   const RenderParams& p = m_params;
   const Camera& cam = m_scene.camera;
   Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
   Vec2 lens = cam.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};  // a pinhole needs none
-  return cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens);
+  cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens, r);
 }
 
 bool RenderSession::add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples, uint64_t& nonfinite) {
@@ -64,7 +64,9 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
           ++rays;  // the camera ray the path loop would have cast and missed
         } else {
           Sampler rng(p.sampler, p.seed, pixel_index, m_first_sample + s);
-          l = trace(m_scene, p, camera_ray(fx, fy_up, rng), rng, rays);
+          Ray ray;
+          camera_ray(fx, fy_up, rng, ray);
+          l = trace(m_scene, p, ray, rng, rays);
         }
         if (add_sample(i, s, l, samples, nonfinite)) {
           m_done[i] = 1;
@@ -137,13 +139,16 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           if (test < end) end = test, again = true;
         }
         for (uint32_t s = c; s < end; ++s) {
+          Job& job = jobs.emplace_back();  // fields stored in place: a braced temporary is copied
+          job.pixel = uint32_t(i);         // with one wide load of narrow stores, which stalls
+          job.sample = s;
           if (background) {
-            jobs.push_back({uint32_t(i), s, -1});
+            job.traced = -1;
             continue;
           }
           rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
-          camera_rays.push_back(camera_ray(fx, fy_up, rngs.back()));
-          jobs.push_back({uint32_t(i), s, int32_t(camera_rays.size() - 1)});
+          camera_ray(fx, fy_up, rngs.back(), camera_rays.emplace_back());  // in place: see spawn_ray
+          job.traced = int32_t(camera_rays.size() - 1);
         }
         if (jobs.size() >= kJobs) flush();
       }
