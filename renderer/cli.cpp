@@ -74,6 +74,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--generic") { p.generic = true; }
     else if (a == "--no-caustic-tracing") { p.caustic_tracing = false; }
     else if (a == "--no-ray-packets") { p.ray_packets = false; }
+    else if (a == "--no-simd-lanes") { p.simd_lanes = false; }
     else if (a == "--sampler") {
       need(a, 1);
       std::string v = args[++i];
@@ -143,6 +144,7 @@ std::string usage_text(const std::string& program) {
 "  --generic       run the path loop with every feature (for comparisons with the specialised one)\n"
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
 "  --no-ray-packets      trace camera paths one at a time instead of many in Embree packets of 16\n"
+"  --no-simd-lanes       shade packets' diffuse vertices one at a time instead of four in SSE2 lanes\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"
 "\n"
 "Error against run time:\n"

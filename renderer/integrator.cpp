@@ -4,6 +4,9 @@
 // Depth: a camera ray has max_depth levels; each bounce (diffuse, glossy or specular) uses one.
 // m = 0 shows emitters only; m = 1 adds direct light; all bounce orders up to m are summed.
 // MIS: Veach 1997 ch. 9, power heuristic, light sampling taking `light_samples` samples.
+#include <memory>
+
+#include "diffuse_lanes.h"
 #include "materials.h"
 #include "render.h"
 #include "sampler.h"
@@ -251,22 +254,113 @@ Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray,
   }
 }
 
+// A path of the pool, and a shadow ray's share of its vertex's light.
+struct PoolSlot {
+  PathState st;
+  uint32_t job;
+  PoolSlot(const Ray& camera_ray, int max_depth, uint32_t job) : st(camera_ray, max_depth), job(job) {}
+};
+struct PendingShadow {
+  uint32_t slot;
+  Vec3 contribution;
+};
+
+// path_step for the pool's slots `which`, all of them at a diffuse hit with depth left, in SSE2
+// lanes: the draws in path_step's order (light samples, the unused lobe number, the bounce,
+// roulette), light passes light by light, the bounce. The same bits as path_step.
+void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lanes::DiffuseVertices& v, const std::vector<uint32_t>& which,
+                      std::vector<PoolSlot>& slots, Sampler* rngs, const SurfaceHit* hits, uint8_t* alive,
+                      uint64_t& rays, std::vector<Ray>& shadow_rays, std::vector<PendingShadow>& shadows) {
+  const int n = int(which.size()), padded = (n + 3) & ~3;
+  const size_t nl = scene.lights.size() * size_t(params.light_samples);  // draws, light by light
+  static thread_local std::vector<Vec2> u_light;
+  u_light.resize(size_t(n) * nl);
+  for (int j = 0; j < padded; ++j) {
+    const uint32_t i = which[size_t(j < n ? j : 0)];  // padding lanes repeat the first vertex
+    PathState& st = slots[i].st;
+    const SurfaceHit& h = hits[i];
+    const Vec3 albedo = scene.materials[h.material].albedo;
+    v.px[j] = h.p.x, v.py[j] = h.p.y, v.pz[j] = h.p.z;
+    v.gx[j] = h.ng.x, v.gy[j] = h.ng.y, v.gz[j] = h.ng.z;
+    v.nx[j] = h.ns.x, v.ny[j] = h.ns.y, v.nz[j] = h.ns.z;
+    v.offset[j] = h.offset;
+    v.ax[j] = albedo.x, v.ay[j] = albedo.y, v.az[j] = albedo.z;
+    v.dx[j] = st.ray.d.x, v.dy[j] = st.ray.d.y, v.dz[j] = st.ray.d.z;
+    v.bx[j] = st.beta.x, v.by[j] = st.beta.y, v.bz[j] = st.beta.z;
+    if (j >= n) {
+      v.ubx[j] = v.ubx[0], v.uby[j] = v.uby[0], v.urr[j] = v.urr[0];
+      continue;
+    }
+    Sampler& rng = rngs[slots[i].job];
+    for (size_t l = 0; l < nl; ++l) u_light[size_t(j) * nl + l] = rng.next_2d();
+    rng.skip_1d();
+    Vec2 u = rng.next_2d();
+    v.ubx[j] = u.x, v.uby[j] = u.y;
+    v.urr[j] = st.bounce >= kRouletteStart ? rng.next_float() : 2.0f;  // 2: no roulette
+    st.has_direct = true;
+    st.direct_beta = st.beta;
+  }
+  for (size_t l = 0; l < nl; ++l) {
+    const Light& light = scene.lights[l / size_t(params.light_samples)];
+    if (is_black(light.color)) continue;
+    for (int j = 0; j < padded; ++j) {
+      Vec2 u = u_light[size_t(j < n ? j : 0) * nl + l];
+      v.ulx[j] = u.x, v.uly[j] = u.y;
+      if (light.kind == LightKind::mesh) {
+        Vec3 q, normal;
+        sample_area_light_point(light, u, q, normal);
+        v.qx[j] = q.x, v.qy[j] = q.y, v.qz[j] = q.z;
+        v.lx[j] = normal.x, v.ly[j] = normal.y, v.lz[j] = normal.z;
+      }
+    }
+    lanes::light_pass(v, padded, light, params.light_samples);
+    for (int j = 0; j < n; ++j) {
+      if (!v.shadow[j]) continue;
+      ++rays;
+      Ray& r = shadow_rays.emplace_back();
+      r.o = Vec3(v.sox[j], v.soy[j], v.soz[j]);
+      r.d = Vec3(v.sdx[j], v.sdy[j], v.sdz[j]);
+      r.tmin = 0;
+      r.tmax = 1 - 1e-4f;  // as spawn_ray_to
+      PendingShadow& s = shadows.emplace_back();
+      s.slot = which[size_t(j)];
+      s.contribution = Vec3(v.cx[j], v.cy[j], v.cz[j]);
+    }
+  }
+  lanes::bounce_pass(v, padded);
+  for (int j = 0; j < n; ++j) {
+    const uint32_t i = which[size_t(j)];
+    PathState& st = slots[i].st;
+    const int bounce = st.bounce++;
+    alive[i] = v.alive[j] != 0;
+    if (!alive[i]) continue;
+    st.beta = Vec3(v.bx[j], v.by[j], v.bz[j]);
+    st.specular = false;
+    if (bounce == 0) st.caustic_phase = 1;
+    else if (st.caustic_phase == 2) st.caustic_phase = 0;
+    st.prev_pdf = v.pdf[j];
+    st.prev_p = hits[i].p;
+    --st.depth_left;
+    st.ray.o = Vec3(v.ox[j], v.oy[j], v.oz[j]);
+    st.ray.d = Vec3(v.wx[j], v.wy[j], v.wz[j]);
+    st.ray.tmin = 0;
+    st.ray.tmax = kInf;
+  }
+}
+
 // Many paths at once (Embree packets of 16): a pool of paths advances one vertex at a time, all
 // their rays traced together, then all their shadow rays; a finished path's slot takes the next
 // one. The same paths as the scalar loop, up to the packet kernel's rounding of a few hits.
 template <uint32_t F>
 void trace_paths_t(const RenderScene& scene, const RenderParams& params, const Ray* camera_rays, Sampler* rngs,
                    size_t n, Vec3* out, uint64_t& rays) {
-  constexpr size_t kSlots = 256;  // 64 to 4096 measured the same on CBdragon
-  struct Slot {
-    PathState st;
-    uint32_t job;
-    Slot(const Ray& camera_ray, int max_depth, uint32_t job) : st(camera_ray, max_depth), job(job) {}
-  };
-  struct Shadow {
-    uint32_t slot;
-    Vec3 contribution;
-  };
+  constexpr size_t kSlots = lanes::kMaxLanes;  // 64 to 4096 measured the same on CBdragon
+  using Slot = PoolSlot;
+  using Shadow = PendingShadow;
+  const bool use_lanes = diffuse_lanes_apply(scene, params);
+  static thread_local std::unique_ptr<lanes::DiffuseVertices> lane_data;
+  if (use_lanes && !lane_data) lane_data = std::make_unique<lanes::DiffuseVertices>();
+  std::vector<uint32_t> in_lanes;
   std::vector<Slot> slots;
   slots.reserve(kSlots);
   std::vector<Ray> ray_buf(kSlots), shadow_rays;
@@ -286,7 +380,13 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
     scene.accel->intersect_many(ray_buf.data(), m, hits.data(), found.data());
     shadow_rays.clear();
     shadows.clear();
+    in_lanes.clear();
     for (size_t i = 0; i < m; ++i) {
+      if (use_lanes && found[i] && slots[i].st.depth_left > 0 &&
+          scene.materials[hits[i].material].type == MaterialType::diffuse) {
+        in_lanes.push_back(uint32_t(i));
+        continue;
+      }
       auto shadow = [&](const SurfaceHit& hit, const LightSample& ls, Vec3 contribution) {
         shadow_ray(hit, ls, shadow_rays.emplace_back());  // in place: see spawn_ray
         Shadow& s = shadows.emplace_back();
@@ -295,6 +395,8 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
       };
       alive[i] = path_step<F>(scene, params, slots[i].st, found[i] != 0, hits[i], rngs[slots[i].job], rays, shadow);
     }
+    if (!in_lanes.empty())
+      diffuse_in_lanes(scene, params, *lane_data, in_lanes, slots, rngs, hits.data(), alive.data(), rays, shadow_rays, shadows);
     blocked.resize(shadow_rays.size());
     scene.accel->occluded_many(shadow_rays.data(), shadow_rays.size(), blocked.data());
     for (size_t k = 0; k < shadows.size(); ++k)  // in order: each vertex sums its lights as the scalar loop does
@@ -314,6 +416,13 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
 }
 
 }  // namespace
+
+bool diffuse_lanes_apply(const RenderScene& scene, const RenderParams& params) {
+  if (!params.simd_lanes || params.hemisphere || params.light_samples < 1) return false;
+  for (const Light& light : scene.lights)  // the lanes know no other light
+    if (light.kind != LightKind::rect && light.kind != LightKind::mesh) return false;
+  return true;
+}
 
 Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, Sampler& rng, uint64_t& rays) {
   return trace_path_t<kFeatAll>(scene, params, ray, rng, rays);

@@ -39,6 +39,8 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
               f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
   std::printf("ray queries:      %s\n",
               o.params.ray_packets && !o.params.hemisphere ? "paths in packets of 16" : "one path at a time");
+  std::printf("diffuse vertices: %s\n",
+              o.params.ray_packets && diffuse_lanes_apply(scene, o.params) ? "four at a time (SSE2 lanes)" : "one at a time");
   std::printf("render memory:    %.2f MiB (%.1f bytes per primitive: BVH, vertices, indices, shading data)\n",
               bytes / 1048576.0, prims ? double(bytes) / prims : 0.0);
   std::printf("load + build:     %.3f s\n", load_s);

@@ -43,6 +43,7 @@ struct RenderParams {
   int tile_size = 32;
   bool generic = false;            // --generic: the path loop with every feature (for comparisons)
   bool ray_packets = true;         // --no-ray-packets: trace paths one at a time, not in packets of 16
+  bool simd_lanes = true;          // --no-simd-lanes: packets' diffuse vertices one at a time, not in lanes of 4
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
   bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
   // Set by RenderSession, not by users: its light tracer renders the caustic paths (caustics.h),
@@ -132,6 +133,9 @@ PathTracer path_tracer_for(uint32_t feature_bits);
 using PathBatchTracer = void (*)(const RenderScene&, const RenderParams&, const Ray* camera_rays, class Sampler* rngs,
                                  size_t n, Vec3* out, uint64_t& rays);
 PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const RenderParams& params);
+// Whether the batched loop takes its diffuse vertices four at a time in SSE2 lanes
+// (diffuse_lanes.h): packets, every light an area light (rectangle or mesh), and not --no-simd-lanes.
+bool diffuse_lanes_apply(const RenderScene& scene, const RenderParams& params);
 
 // The course's adaptive-sampling test for one pixel with n > 1 luminance samples of sum s1 and
 // sum of squares s2: the 95% confidence half-width is within tolerance x mean. Shared by the

@@ -81,28 +81,7 @@ SeedStats over_seeds(const SceneDesc& desc, RenderParams p, int seeds) {
 // samples its triangles) and the white surfaces into rough metal (splats evaluate a microfacet BRDF).
 SceneDesc mesh_light_metal_cornell() {
   SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
-  std::vector<LightDesc> kept;
-  for (const LightDesc& l : desc.lights) {
-    if (l.type != LightType::area) {
-      kept.push_back(l);
-      continue;
-    }
-    Material em;
-    em.name = l.name + " (mesh)";
-    em.type = MaterialType::emission;
-    em.radiance = l.color;
-    desc.materials.push_back(em);
-    MeshDesc m;
-    m.name = l.name;
-    Vec3 hx = l.dim_x * 0.5f, hy = l.dim_y * 0.5f;
-    m.positions = {l.position - hx - hy, l.position + hx - hy, l.position + hx + hy, l.position - hx + hy};
-    // Emitters emit on their winding's side: wind the quad to face the light's direction.
-    if (dot(cross(l.dim_x, l.dim_y), l.direction) > 0) m.indices = {0, 1, 2, 0, 2, 3};
-    else m.indices = {0, 2, 1, 0, 3, 2};
-    m.tri_material = {int(desc.materials.size()) - 1, int(desc.materials.size()) - 1};
-    desc.meshes.push_back(m);
-  }
-  desc.lights = kept;
+  test::area_lights_as_meshes(desc);
   for (Material& m : desc.materials)
     if (m.name == "white") {
       m.type = MaterialType::microfacet;

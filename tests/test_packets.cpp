@@ -89,6 +89,63 @@ TEST(Packets, BatchedPathsRenderWhatThePathByPathLoopRenders) {
   }
 }
 
+// The SSE2 lanes (diffuse_lanes.h) repeat path_step's arithmetic operation for operation: with
+// them and without, the batched loop must render the same bits, count the same rays and stop
+// the same pixels. Depth 8 makes paths reach Russian roulette (from the sixth vertex).
+TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
+  std::vector<Case> all = cases();
+  for (Case& c : all) c.params.max_depth = 8;
+  all.push_back({"dof, depth 8", test::own_scene("dof.dae"), all[0].params});
+  all.push_back({"cornell with a mesh light, depth 8", "", all[0].params});
+  int laned = 0;
+  for (const Case& c : all) {
+    SCOPED_TRACE(c.name);
+    SceneDesc desc = load_collada(c.path.empty() ? test::own_scene("cornell.dae") : c.path);
+    if (c.path.empty()) test::area_lights_as_meshes(desc);  // sampled by triangle before the lanes
+    RenderParams p = c.params;
+    auto scene = make_render_scene(desc, p);
+    const bool lanes = diffuse_lanes_apply(*scene, p);
+    laned += lanes;
+    RenderSession with(*scene, p);
+    with.render_all();
+    p.simd_lanes = false;
+    EXPECT_FALSE(diffuse_lanes_apply(*scene, p));
+    RenderSession without(*scene, p);
+    without.render_all();
+    ImageRGB a = with.image(), b = without.image();
+    ASSERT_EQ(a.pixels.size(), b.pixels.size());
+    EXPECT_EQ(differing_pixels(a, b), 0u);
+    EXPECT_EQ(with.stats().rays, without.stats().rays);
+    EXPECT_EQ(with.pixel_counts(), without.pixel_counts());
+    EXPECT_EQ(with.stats().nonfinite, 0u);
+  }
+  EXPECT_GE(laned, 6) << "the own scenes' lights take the lanes: rectangles (1 or 3 samples), a mesh";
+}
+
+TEST(Packets, DiffuseLanesTakeOnlyAreaLights) {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  RenderParams p;
+  auto scene = make_render_scene(desc, p);
+  EXPECT_TRUE(diffuse_lanes_apply(*scene, p));
+  p.light_samples = 4;
+  EXPECT_TRUE(diffuse_lanes_apply(*scene, p));
+  p.hemisphere = true;
+  EXPECT_FALSE(diffuse_lanes_apply(*scene, p));
+  p.hemisphere = false;
+  SceneDesc meshed = desc;
+  test::area_lights_as_meshes(meshed);
+  auto mesh_lit = make_render_scene(meshed, p);
+  ASSERT_EQ(mesh_lit->lights.size(), 1u);
+  EXPECT_EQ(mesh_lit->lights[0].kind, LightKind::mesh);
+  EXPECT_TRUE(diffuse_lanes_apply(*mesh_lit, p));
+  RenderScene other = *scene;
+  Light point;
+  point.kind = LightKind::point;
+  point.color = Vec3(1.0f);
+  other.lights.push_back(point);
+  EXPECT_FALSE(diffuse_lanes_apply(other, p));
+}
+
 TEST(Packets, HemisphereSamplingTracesPathByPath) {
   SceneDesc desc = load_collada(test::own_scene("dof.dae"));
   RenderParams p;

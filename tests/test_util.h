@@ -8,6 +8,7 @@
 #include <cmath>
 #include <string>
 
+#include "collada.h"
 #include "image.h"
 
 namespace pt::test {
@@ -68,6 +69,32 @@ inline std::string uniform_sky(const std::string& name, Vec3 colour) {
   std::string path = temp_dir() + "/" + name;
   write_image(env, path);
   return path;
+}
+
+// Turns the scene's area lights into emissive quads (mesh lights: sampled by triangle), wound to
+// emit towards the light's direction.
+inline void area_lights_as_meshes(SceneDesc& desc) {
+  std::vector<LightDesc> kept;
+  for (const LightDesc& l : desc.lights) {
+    if (l.type != LightType::area) {
+      kept.push_back(l);
+      continue;
+    }
+    Material em;
+    em.name = l.name + " (mesh)";
+    em.type = MaterialType::emission;
+    em.radiance = l.color;
+    desc.materials.push_back(em);
+    MeshDesc m;
+    m.name = l.name;
+    Vec3 hx = l.dim_x * 0.5f, hy = l.dim_y * 0.5f;
+    m.positions = {l.position - hx - hy, l.position + hx - hy, l.position + hx + hy, l.position - hx + hy};
+    if (dot(cross(l.dim_x, l.dim_y), l.direction) > 0) m.indices = {0, 1, 2, 0, 2, 3};
+    else m.indices = {0, 2, 1, 0, 3, 2};
+    m.tri_material = {int(desc.materials.size()) - 1, int(desc.materials.size()) - 1};
+    desc.meshes.push_back(m);
+  }
+  desc.lights = kept;
 }
 
 }  // namespace pt::test
