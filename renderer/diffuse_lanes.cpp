@@ -60,7 +60,7 @@ inline V3 offset_origin(V3 p, V3 n) {
 struct Shading {
   V3 ng, s, t, n, wo;  // wo local
 };
-inline Shading shading(const DiffuseVertices& v, int i) {
+__attribute__((always_inline)) inline Shading shading(const DiffuseVertices& v, int i) {
   Shading sh;
   V3 wo_world = neg(load3(v.dx, v.dy, v.dz, i));
   V3 ng = load3(v.gx, v.gy, v.gz, i), ns = load3(v.nx, v.ny, v.nz, i);

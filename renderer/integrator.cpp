@@ -314,15 +314,19 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
       }
     }
     lanes::light_pass(v, padded, light, params.light_samples);
+    size_t k = shadow_rays.size(), count = 0;
+    for (int j = 0; j < n; ++j) count += v.shadow[j] != 0;
+    shadow_rays.resize(k + count);
+    shadows.resize(k + count);
+    rays += count;
     for (int j = 0; j < n; ++j) {
       if (!v.shadow[j]) continue;
-      ++rays;
-      Ray& r = shadow_rays.emplace_back();
+      Ray& r = shadow_rays[k];
       r.o = Vec3(v.sox[j], v.soy[j], v.soz[j]);
       r.d = Vec3(v.sdx[j], v.sdy[j], v.sdz[j]);
       r.tmin = 0;
       r.tmax = 1 - 1e-4f;  // as spawn_ray_to
-      PendingShadow& s = shadows.emplace_back();
+      PendingShadow& s = shadows[k++];
       s.slot = which[size_t(j)];
       s.contribution = Vec3(v.cx[j], v.cy[j], v.cz[j]);
     }
