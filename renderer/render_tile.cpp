@@ -36,6 +36,29 @@ bool RenderSession::add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples, 
          confidence_reached(m_s1[i], m_s2[i], n, m_params.adaptive_tolerance);
 }
 
+// Samples [from, to) of pixel i that sees only background: add_sample with l = 0 for each, minus
+// the sums, which adding zeros leaves as they are. Stops after the first adaptive test that passes;
+// returns the number of samples added.
+uint32_t RenderSession::add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stopped) {
+  const uint32_t batch = uint32_t(std::max(1, m_params.adaptive_batch));
+  stopped = false;
+  uint32_t s = from;
+  while (s < to) {
+    if (s > 0 && (s & (s - 1)) == 0) {
+      m_half_s1[i] = m_s1[i];
+      m_half_n[i] = s;
+    }
+    const uint32_t n = ++s;
+    if (m_params.adaptive && n > 1 && (n - 1) % batch == 0 &&
+        confidence_reached(m_s1[i], m_s2[i], n, m_params.adaptive_tolerance)) {
+      stopped = true;
+      break;
+    }
+  }
+  m_count[i] = s;
+  return s - from;
+}
+
 void RenderSession::render_tile(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,
                                 uint64_t& samples, uint64_t& nonfinite) {
   const RenderParams& p = m_params;
@@ -92,7 +115,7 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   constexpr size_t kJobs = 2048;  // paths per batch: bounds memory and the latency of a cancel
   struct Job {
     uint32_t pixel, sample;
-    int32_t traced;  // index into the batch's rays, or -1 for a background sample
+    uint32_t traced;  // index into the batch's rays
   };
   std::vector<Job> jobs;
   std::vector<Ray> camera_rays;
@@ -112,11 +135,8 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   auto flush = [&] {
     out.resize(camera_rays.size());
     if (!camera_rays.empty()) trace(m_scene, p, camera_rays.data(), rngs.data(), camera_rays.size(), out.data(), rays);
-    for (const Job& j : jobs) {
-      if (j.traced < 0) ++rays;  // the camera ray the path loop would have cast and missed
-      if (add_sample(j.pixel, j.sample, j.traced < 0 ? Vec3(0.0f) : out[size_t(j.traced)], samples, nonfinite))
-        m_done[j.pixel] = 1;
-    }
+    for (const Job& j : jobs)
+      if (add_sample(j.pixel, j.sample, out[j.traced], samples, nonfinite)) m_done[j.pixel] = 1;
     jobs.clear();
     camera_rays.clear();
     rngs.clear();
@@ -138,17 +158,21 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           uint32_t test = 1 + batch * ((std::max(c, 1u) + batch - 1) / batch);
           if (test < end) end = test, again = true;
         }
+        if (background) {  // zeros of its own: no job, no ray (but counted as the camera ray it would be)
+          bool stop;
+          uint32_t added = add_zero_samples(i, c, end, stop);
+          rays += added;
+          samples += added;
+          if (stop) m_done[i] = 1;
+          continue;
+        }
         for (uint32_t s = c; s < end; ++s) {
           Job& job = jobs.emplace_back();  // fields stored in place: a braced temporary is copied
           job.pixel = uint32_t(i);         // with one wide load of narrow stores, which stalls
           job.sample = s;
-          if (background) {
-            job.traced = -1;
-            continue;
-          }
           rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
           camera_ray(fx, fy_up, rngs.back(), camera_rays.emplace_back());  // in place: see spawn_ray
-          job.traced = int32_t(camera_rays.size() - 1);
+          job.traced = uint32_t(camera_rays.size() - 1);
         }
         if (jobs.size() >= kJobs) flush();
       }
