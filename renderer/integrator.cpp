@@ -135,7 +135,21 @@ struct PathState {
   int depth_left = 0;
   int bounce = 0;
 
-  PathState(const Ray& camera_ray, int max_depth) : ray(camera_ray), depth_left(max_depth) {}
+  PathState() = default;
+  PathState(const Ray& camera_ray, int max_depth) { start(camera_ray, max_depth); }
+  // Every field set in place (a pool slot takes its next path here; see spawn_ray in accel.h).
+  void start(const Ray& camera_ray, int max_depth) {
+    ray = camera_ray;
+    radiance = Vec3(0.0f), beta = Vec3(1.0f);
+    direct_beta = Vec3(0.0f), direct_sum = Vec3(0.0f);
+    has_direct = false;
+    specular = true;
+    caustic_phase = 0;
+    prev_pdf = 0;
+    prev_p = Vec3();
+    depth_left = max_depth;
+    bounce = 0;
+  }
   // Adds the current vertex's light sampling, after its shadow rays (and before the next vertex).
   void resolve_direct() {
     if (has_direct) radiance += direct_beta * direct_sum;
@@ -257,8 +271,7 @@ Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray,
 // A path of the pool, and a shadow ray's share of its vertex's light.
 struct PoolSlot {
   PathState st;
-  uint32_t job;
-  PoolSlot(const Ray& camera_ray, int max_depth, uint32_t job) : st(camera_ray, max_depth), job(job) {}
+  uint32_t job = 0;
 };
 struct PendingShadow {
   uint32_t slot;
@@ -365,20 +378,20 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   static thread_local std::unique_ptr<lanes::DiffuseVertices> lane_data;
   if (use_lanes && !lane_data) lane_data = std::make_unique<lanes::DiffuseVertices>();
   std::vector<uint32_t> in_lanes;
-  std::vector<Slot> slots;
-  slots.reserve(kSlots);
+  std::vector<Slot> slots(kSlots);
+  size_t live = 0;  // slots [0, live) hold paths
   std::vector<Ray> ray_buf(kSlots), shadow_rays;
   std::vector<SurfaceHit> hits(kSlots);
   std::vector<uint8_t> found(kSlots), alive(kSlots), blocked;
   std::vector<Shadow> shadows;
   size_t next = 0;
   for (;;) {
-    while (slots.size() < kSlots && next < n) {
-      slots.emplace_back(camera_rays[next], params.max_depth, uint32_t(next));
-      ++next;
+    for (; live < kSlots && next < n; ++live, ++next) {
+      slots[live].st.start(camera_rays[next], params.max_depth);
+      slots[live].job = uint32_t(next);
     }
-    if (slots.empty()) return;
-    const size_t m = slots.size();
+    if (live == 0) return;
+    const size_t m = live;
     for (size_t i = 0; i < m; ++i) ray_buf[i] = slots[i].st.ray;
     rays += m;
     scene.accel->intersect_many(ray_buf.data(), m, hits.data(), found.data());
@@ -405,16 +418,16 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
     scene.accel->occluded_many(shadow_rays.data(), shadow_rays.size(), blocked.data());
     for (size_t k = 0; k < shadows.size(); ++k)  // in order: each vertex sums its lights as the scalar loop does
       if (!blocked[k]) slots[shadows[k].slot].st.direct_sum += shadows[k].contribution;
-    for (size_t i = 0; i < slots.size();) {
+    for (size_t i = 0; i < live;) {
       slots[i].st.resolve_direct();
       if (alive[i]) {
         ++i;
         continue;
       }
       out[slots[i].job] = slots[i].st.radiance;
-      slots[i] = slots.back();
-      alive[i] = alive[slots.size() - 1];
-      slots.pop_back();
+      --live;
+      slots[i] = slots[live];
+      alive[i] = alive[live];
     }
   }
 }
