@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "sampling.h"
+#include "simd.h"
 
 namespace pt {
 
@@ -129,6 +130,27 @@ void Camera::pinhole_ray(float sx, float sy, Ray& r) const {
   r.d = normalize(right * dc.x + up * dc.y + back * dc.z);
   r.tmin = tmin;
   r.tmax = tmax;
+}
+
+void Camera::pinhole_rays(const float* sx, const float* sy, size_t n, Ray* out) const {
+  using namespace simd;
+  const V3 r = broadcast(right), u = broadcast(up), b = broadcast(back);
+  const vf one = splat(1.0f), two = splat(2.0f);
+  size_t i = 0;
+  for (; i + 4 <= n; i += 4) {  // pinhole_ray, operation for operation
+    vf dcx = (two * loadu(sx + i) - one) * splat(tan_half_w), dcy = (two * loadu(sy + i) - one) * splat(tan_half_h);
+    V3 d = add(add(mul(r, dcx), mul(u, dcy)), mul(b, splat(-1.0f)));
+    vf l = sqrt(dot(d, d));
+    d = sel(l > 0, mul(d, one / l), V3{vf{}, vf{}, vf{}});
+    for (int k = 0; k < 4; ++k) {
+      Ray& ray = out[i + size_t(k)];
+      ray.o = position;
+      ray.d = Vec3(d.x[k], d.y[k], d.z[k]);
+      ray.tmin = tmin;
+      ray.tmax = tmax;
+    }
+  }
+  for (; i < n; ++i) pinhole_ray(sx[i], sy[i], out[i]);
 }
 
 Ray Camera::pinhole_ray(float sx, float sy) const {

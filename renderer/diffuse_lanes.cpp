@@ -4,45 +4,13 @@
 // scalar path_step's bits. No FMA: the portable build has none, and contraction would change them.
 #include "diffuse_lanes.h"
 
-#include "math.h"
+#include "simd.h"
 
 namespace pt::lanes {
 
 namespace {
 
-typedef float vf __attribute__((vector_size(16)));
-typedef int32_t vi __attribute__((vector_size(16)));
-
-struct V3 {
-  vf x, y, z;
-};
-
-inline vf splat(float f) { return vf{f, f, f, f}; }
-inline vf load(const float* p) { return *reinterpret_cast<const vf*>(p); }
-inline void store(float* p, vf a) { *reinterpret_cast<vf*>(p) = a; }
-inline void storei(int* p, vi a) { *reinterpret_cast<vi*>(p) = a; }
-inline V3 load3(const float* x, const float* y, const float* z, int i) { return {load(x + i), load(y + i), load(z + i)}; }
-inline void store3(float* x, float* y, float* z, int i, V3 a) {
-  store(x + i, a.x);
-  store(y + i, a.y);
-  store(z + i, a.z);
-}
-
-inline vf sel(vi mask, vf a, vf b) { return mask ? a : b; }
-inline V3 sel(vi mask, V3 a, V3 b) { return {sel(mask, a.x, b.x), sel(mask, a.y, b.y), sel(mask, a.z, b.z)}; }
-inline V3 neg(V3 a) { return {-a.x, -a.y, -a.z}; }
-inline V3 add(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 mul(V3 a, V3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-inline V3 mul(V3 a, vf s) { return {a.x * s, a.y * s, a.z * s}; }
-inline V3 broadcast(Vec3 a) { return {splat(a.x), splat(a.y), splat(a.z)}; }
-inline vf dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline vf sqrt(vf a) { return vf(_mm_sqrt_ps(__m128(a))); }
-inline vf fabs(vf a) { return vf(vi(a) & 0x7fffffff); }
-inline vi is_finite(vf a) { return (vi(a) & 0x7f800000) != 0x7f800000; }
-inline vi is_black(V3 a) { return (a.x == 0) & (a.y == 0) & (a.z == 0); }
-inline vi all_finite(V3 a) { return is_finite(a.x) & is_finite(a.y) & is_finite(a.z); }
-inline vf max0(vf a) { return sel(vf{} < a, a, vf{}); }  // std::max(0.0f, a)
+using namespace simd;
 
 // offset_ray_origin (accel.h), one coordinate.
 inline vf offset_coordinate(vf p, vf n) {

@@ -5,8 +5,6 @@
 // into these arrays, runs the lanes, and scatters the results back (integrator.cpp).
 #pragma once
 
-#include <emmintrin.h>
-
 #include <cstdint>
 
 #include "lights.h"

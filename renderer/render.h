@@ -248,6 +248,8 @@ class RenderSession {
   // Adds sample s of pixel i; true when the course's adaptive test stops the pixel there.
   bool add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples, uint64_t& nonfinite);
   uint32_t add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stopped);
+  // The pixel sample's point on the sensor (its jitter draw), and its camera ray (+ the lens draw).
+  Vec2 sensor_sample(int fx, int fy_up, Sampler& rng) const;
   void camera_ray(int fx, int fy_up, Sampler& rng, Ray& r) const;
 
   const RenderScene& m_scene;

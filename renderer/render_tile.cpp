@@ -6,12 +6,17 @@
 
 namespace pt {
 
-void RenderSession::camera_ray(int fx, int fy_up, Sampler& rng, Ray& r) const {
+Vec2 RenderSession::sensor_sample(int fx, int fy_up, Sampler& rng) const {
   const RenderParams& p = m_params;
-  const Camera& cam = m_scene.camera;
   Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
+  return {(fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height};
+}
+
+void RenderSession::camera_ray(int fx, int fy_up, Sampler& rng, Ray& r) const {
+  const Camera& cam = m_scene.camera;
+  Vec2 s = sensor_sample(fx, fy_up, rng);
   Vec2 lens = cam.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};  // a pinhole needs none
-  cam.generate_ray((fx + jitter.x) / p.width, (fy_up + jitter.y) / p.height, lens, r);
+  cam.generate_ray(s.x, s.y, lens, r);
 }
 
 bool RenderSession::add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples, uint64_t& nonfinite) {
@@ -119,6 +124,8 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   };
   std::vector<Job> jobs;
   std::vector<Ray> camera_rays;
+  std::vector<float> sensor_x, sensor_y;  // a pinhole's rays are made at the flush, four at a time
+  const bool pinhole = m_scene.camera.lens_radius <= 0;
   std::vector<Sampler> rngs;
   std::vector<Vec3> out;
   // Each pixel's count before this pass, for the progress credit; kDone: finished before it.
@@ -133,6 +140,12 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
 
   bool stopped = false;
   auto flush = [&] {
+    if (pinhole) {
+      camera_rays.resize(sensor_x.size());
+      m_scene.camera.pinhole_rays(sensor_x.data(), sensor_y.data(), sensor_x.size(), camera_rays.data());
+      sensor_x.clear();
+      sensor_y.clear();
+    }
     out.resize(camera_rays.size());
     if (!camera_rays.empty()) trace(m_scene, p, camera_rays.data(), rngs.data(), camera_rays.size(), out.data(), rays);
     for (const Job& j : jobs)
@@ -170,9 +183,15 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           Job& job = jobs.emplace_back();  // fields stored in place: a braced temporary is copied
           job.pixel = uint32_t(i);         // with one wide load of narrow stores, which stalls
           job.sample = s;
-          rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
-          camera_ray(fx, fy_up, rngs.back(), camera_rays.emplace_back());  // in place: see spawn_ray
-          job.traced = uint32_t(camera_rays.size() - 1);
+          Sampler& rng = rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
+          job.traced = uint32_t(rngs.size() - 1);
+          if (pinhole) {
+            Vec2 sensor = sensor_sample(fx, fy_up, rng);
+            sensor_x.push_back(sensor.x);
+            sensor_y.push_back(sensor.y);
+          } else {
+            camera_ray(fx, fy_up, rng, camera_rays.emplace_back());  // in place: see spawn_ray
+          }
         }
         if (jobs.size() >= kJobs) flush();
       }

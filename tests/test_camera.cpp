@@ -216,3 +216,34 @@ TEST(Camera, KeepFovScalesTheCourseViewInsteadOfCropping) {
   Camera cropped = make_camera(s, p);
   EXPECT_NEAR(cropped.tan_half_w, full.tan_half_w * 0.6f, 1e-6);
 }
+
+// Camera rays four at a time (render_tile's pinhole batches) must be pinhole_ray's bits, for any
+// count (the tail of fewer than four goes one by one) and sensor points on and off the sensor.
+TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
+  SceneDesc s = box_scene();
+  CameraParams cp;
+  cp.width = 480;
+  cp.height = 360;
+  Camera c = make_camera(s, cp);
+  Frame tilted(normalize(Vec3(0.3f, -0.5f, 0.8f)));  // every axis mixes x, y and z: sums in order
+  c.right = tilted.s, c.up = tilted.t, c.back = tilted.n;
+  Pcg32 rng(7, 11);
+  for (size_t n : {size_t(0), size_t(1), size_t(4), size_t(7), size_t(1001)}) {
+    std::vector<float> sx(n), sy(n);
+    for (size_t i = 0; i < n; ++i) {
+      sx[i] = 1.4f * rng.next_float() - 0.2f;
+      sy[i] = 1.4f * rng.next_float() - 0.2f;
+    }
+    if (n > 2) sx[1] = sy[1] = 0.5f, sx[2] = 0, sy[2] = 1;  // the centre and a corner exactly
+    std::vector<Ray> lanes(n);
+    c.pinhole_rays(sx.data(), sy.data(), n, lanes.data());
+    for (size_t i = 0; i < n; ++i) {
+      Ray one = c.pinhole_ray(sx[i], sy[i]);
+      SCOPED_TRACE(i);
+      EXPECT_EQ(lanes[i].o, one.o);
+      EXPECT_EQ(lanes[i].d, one.d);
+      EXPECT_EQ(lanes[i].tmin, one.tmin);
+      EXPECT_EQ(lanes[i].tmax, one.tmax);
+    }
+  }
+}
