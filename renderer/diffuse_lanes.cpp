@@ -107,7 +107,7 @@ void bounce_pass(DiffuseVertices& v, int n) {
     vf y = sel(centre, vf{}, sel(wide, ox * s, oy * c));
     vf z = sqrt(max0(one - x * x - y * y));
     vf pdf = sel(z > 0, z * inv_pi, vf{});
-    vi ok = (sh.wo.z > 0) & (pdf > 0);  // diffuse_sample
+    vi ok = ~(sh.wo.z <= 0) & ~(pdf <= 0);  // diffuse_sample's tests, in their form (NaN passes them)
     V3 wi = add(add(mul(sh.s, x), mul(sh.t, y)), mul(sh.n, z));  // Frame::to_world
     ok &= ~(dot(wi, sh.ng) <= 0);  // reflection leaves on the viewer's side
     V3 beta = mul(load3(v.bx, v.by, v.bz, i), load3(v.ax, v.ay, v.az, i));
