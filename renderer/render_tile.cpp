@@ -120,7 +120,6 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   constexpr size_t kJobs = 2048;  // paths per batch: bounds memory and the latency of a cancel
   struct Job {
     uint32_t pixel, sample;
-    uint32_t traced;  // index into the batch's rays
   };
   std::vector<Job> jobs;
   std::vector<Ray> camera_rays;
@@ -148,8 +147,8 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     }
     out.resize(camera_rays.size());
     if (!camera_rays.empty()) trace(m_scene, p, camera_rays.data(), rngs.data(), camera_rays.size(), out.data(), rays);
-    for (const Job& j : jobs)
-      if (add_sample(j.pixel, j.sample, out[j.traced], samples, nonfinite)) m_done[j.pixel] = 1;
+    for (size_t k = 0; k < jobs.size(); ++k)  // job k traced camera ray k
+      if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) m_done[jobs[k].pixel] = 1;
     jobs.clear();
     camera_rays.clear();
     rngs.clear();
@@ -184,7 +183,6 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           job.pixel = uint32_t(i);         // with one wide load of narrow stores, which stalls
           job.sample = s;
           Sampler& rng = rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
-          job.traced = uint32_t(rngs.size() - 1);
           if (pinhole) {
             Vec2 sensor = sensor_sample(fx, fy_up, rng);
             sensor_x.push_back(sensor.x);
