@@ -153,6 +153,35 @@ void Camera::pinhole_rays(const float* sx, const float* sy, size_t n, Ray* out) 
   for (; i < n; ++i) pinhole_ray(sx[i], sy[i], out[i]);
 }
 
+void Camera::generate_rays(const float* sx, const float* sy, const Vec2* lens_u, size_t n, Ray* out) const {
+  if (lens_radius <= 0) return pinhole_rays(sx, sy, n, out);
+  using namespace simd;
+  const V3 r = broadcast(right), u = broadcast(up), b = broadcast(back), o = broadcast(position);
+  const vf one = splat(1.0f), two = splat(2.0f), f = splat(focal_distance), radius = splat(lens_radius);
+  size_t i = 0;
+  for (; i + 4 <= n; i += 4) {  // generate_ray, operation for operation
+    const Vec2* l = lens_u + i;
+    vf dx, dy;
+    concentric_disk(vf{l[0].x, l[1].x, l[2].x, l[3].x}, vf{l[0].y, l[1].y, l[2].y, l[3].y}, dx, dy);
+    V3 dc{(two * loadu(sx + i) - one) * splat(tan_half_w), (two * loadu(sy + i) - one) * splat(tan_half_h), splat(-1.0f)};
+    vf lx = radius * dx, ly = radius * dy;
+    V3 dir{dc.x * f - lx, dc.y * f - ly, dc.z * f - vf{}};
+    dir = sel(dot(dir, dir) > 0, dir, dc);
+    V3 org = add(add(o, mul(r, lx)), mul(u, ly));
+    V3 d = add(add(mul(r, dir.x), mul(u, dir.y)), mul(b, dir.z));
+    vf len = sqrt(dot(d, d));
+    d = sel(len > 0, mul(d, one / len), V3{vf{}, vf{}, vf{}});
+    for (int k = 0; k < 4; ++k) {
+      Ray& ray = out[i + size_t(k)];
+      ray.o = Vec3(org.x[k], org.y[k], org.z[k]);
+      ray.d = Vec3(d.x[k], d.y[k], d.z[k]);
+      ray.tmin = tmin;
+      ray.tmax = tmax;
+    }
+  }
+  for (; i < n; ++i) generate_ray(sx[i], sy[i], lens_u[i], out[i]);
+}
+
 Ray Camera::pinhole_ray(float sx, float sy) const {
   Ray r;
   pinhole_ray(sx, sy, r);

@@ -95,16 +95,8 @@ void bounce_pass(DiffuseVertices& v, int n) {
   const vf one = splat(1.0f), inv_pi = splat(kInvPi);
   for (int i = 0; i < n; i += 4) {
     const Shading sh = shading(v, i);
-    // sample_concentric_disk and sample_cosine_hemisphere (sampling.h)
-    vf ox = splat(2.0f) * load(v.ubx + i) - one, oy = splat(2.0f) * load(v.uby + i) - one;
-    vi wide = fabs(ox) > fabs(oy);
-    vf a = splat(kPi / 4) * sel(wide, oy / ox, ox / oy);
-    vf a2 = a * a;
-    vf s = a * (one + a2 * (splat(-1.0f / 6) + a2 * (splat(1.0f / 120) + a2 * splat(-1.0f / 5040))));
-    vf c = one + a2 * (splat(-0.5f) + a2 * (splat(1.0f / 24) + a2 * (splat(-1.0f / 720) + a2 * splat(1.0f / 40320))));
-    vi centre = (ox == 0) & (oy == 0);
-    vf x = sel(centre, vf{}, sel(wide, ox * c, oy * s));
-    vf y = sel(centre, vf{}, sel(wide, ox * s, oy * c));
+    vf x, y;  // sample_cosine_hemisphere (sampling.h)
+    concentric_disk(load(v.ubx + i), load(v.uby + i), x, y);
     vf z = sqrt(max0(one - x * x - y * y));
     vf pdf = sel(z > 0, z * inv_pi, vf{});
     vi ok = ~(sh.wo.z <= 0) & ~(pdf <= 0);  // diffuse_sample's tests, in their form (NaN passes them)

@@ -286,8 +286,20 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
                       uint64_t& rays, std::vector<Ray>& shadow_rays, std::vector<PendingShadow>& shadows) {
   const int n = int(which.size()), padded = (n + 3) & ~3;
   const size_t nl = scene.lights.size() * size_t(params.light_samples);  // draws, light by light
-  static thread_local std::vector<Vec2> u_light;
+  static thread_local std::vector<Vec2> u_light, u;
+  static thread_local std::vector<Sampler*> samplers;
   u_light.resize(size_t(n) * nl);
+  u.resize(size_t(n));
+  samplers.resize(size_t(n));
+  for (int j = 0; j < n; ++j) samplers[size_t(j)] = &rngs[slots[which[size_t(j)]].job];
+  // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
+  // for all vertices at once: each sampler still sees its own draws in that order.
+  for (size_t l = 0; l < nl; ++l) {
+    Sampler::next_2d_many(samplers.data(), size_t(n), u.data(), params.simd_lanes);
+    for (int j = 0; j < n; ++j) u_light[size_t(j) * nl + l] = u[size_t(j)];
+  }
+  for (Sampler* rng : samplers) rng->skip_1d();
+  Sampler::next_2d_many(samplers.data(), size_t(n), u.data(), params.simd_lanes);
   for (int j = 0; j < padded; ++j) {
     const uint32_t i = which[size_t(j < n ? j : 0)];  // padding lanes repeat the first vertex
     PathState& st = slots[i].st;
@@ -304,12 +316,8 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
       v.ubx[j] = v.ubx[0], v.uby[j] = v.uby[0], v.urr[j] = v.urr[0];
       continue;
     }
-    Sampler& rng = rngs[slots[i].job];
-    for (size_t l = 0; l < nl; ++l) u_light[size_t(j) * nl + l] = rng.next_2d();
-    rng.skip_1d();
-    Vec2 u = rng.next_2d();
-    v.ubx[j] = u.x, v.uby[j] = u.y;
-    v.urr[j] = st.bounce >= kRouletteStart ? rng.next_float() : 2.0f;  // 2: no roulette
+    v.ubx[j] = u[size_t(j)].x, v.uby[j] = u[size_t(j)].y;
+    v.urr[j] = st.bounce >= kRouletteStart ? samplers[size_t(j)]->next_float() : 2.0f;  // 2: no roulette
     st.has_direct = true;
     st.direct_beta = st.beta;
   }

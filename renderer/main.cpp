@@ -41,6 +41,11 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
               o.params.ray_packets && !o.params.hemisphere ? "paths in packets of 16" : "one path at a time");
   std::printf("diffuse vertices: %s\n",
               o.params.ray_packets && diffuse_lanes_apply(scene, o.params) ? "four at a time (SSE2 lanes)" : "one at a time");
+  const bool packets = o.params.ray_packets && !o.params.hemisphere;
+  std::printf("sample draws:     %s\n", packets && o.params.simd_lanes && o.params.sampler == SamplerKind::sobol &&
+                                             Sampler::lanes_available()
+                                         ? "eight at a time (AVX2 lanes)"
+                                         : "one at a time");
   std::printf("render memory:    %.2f MiB (%.1f bytes per primitive: BVH, vertices, indices, shading data)\n",
               bytes / 1048576.0, prims ? double(bytes) / prims : 0.0);
   std::printf("load + build:     %.3f s\n", load_s);

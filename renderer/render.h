@@ -43,7 +43,7 @@ struct RenderParams {
   int tile_size = 32;
   bool generic = false;            // --generic: the path loop with every feature (for comparisons)
   bool ray_packets = true;         // --no-ray-packets: trace paths one at a time, not in packets of 16
-  bool simd_lanes = true;          // --no-simd-lanes: packets' diffuse vertices one at a time, not in lanes of 4
+  bool simd_lanes = true;          // --no-simd-lanes: packets' diffuse vertices and sample draws one at a time
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
   bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
   // Set by RenderSession, not by users: its light tracer renders the caustic paths (caustics.h),

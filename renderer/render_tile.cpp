@@ -122,9 +122,12 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     uint32_t pixel, sample;
   };
   std::vector<Job> jobs;
+  // Camera rays are made at the flush: each job's pixel corner, then its sensor and lens draws
+  // for all jobs at once (Sampler::next_2d_many), then the rays four at a time (generate_rays).
+  std::vector<float> sensor_x, sensor_y;
+  std::vector<Vec2> draws;
   std::vector<Ray> camera_rays;
-  std::vector<float> sensor_x, sensor_y;  // a pinhole's rays are made at the flush, four at a time
-  const bool pinhole = m_scene.camera.lens_radius <= 0;
+  const bool lens = m_scene.camera.lens_radius > 0;
   std::vector<Sampler> rngs;
   std::vector<Vec3> out;
   // Each pixel's count before this pass, for the progress credit; kDone: finished before it.
@@ -139,14 +142,24 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
 
   bool stopped = false;
   auto flush = [&] {
-    if (pinhole) {
-      camera_rays.resize(sensor_x.size());
-      m_scene.camera.pinhole_rays(sensor_x.data(), sensor_y.data(), sensor_x.size(), camera_rays.data());
-      sensor_x.clear();
-      sensor_y.clear();
+    const size_t n = jobs.size();
+    draws.resize(n);
+    if (p.spp == 1) {  // sensor_sample: the pixel centre
+      std::fill(draws.begin(), draws.end(), Vec2{0.5f, 0.5f});
+    } else {
+      Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
     }
-    out.resize(camera_rays.size());
-    if (!camera_rays.empty()) trace(m_scene, p, camera_rays.data(), rngs.data(), camera_rays.size(), out.data(), rays);
+    for (size_t k = 0; k < n; ++k) {
+      sensor_x[k] = (sensor_x[k] + draws[k].x) / float(p.width);
+      sensor_y[k] = (sensor_y[k] + draws[k].y) / float(p.height);
+    }
+    if (lens) Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
+    camera_rays.resize(n);
+    m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
+    sensor_x.clear();
+    sensor_y.clear();
+    out.resize(n);
+    if (n) trace(m_scene, p, camera_rays.data(), rngs.data(), n, out.data(), rays);
     for (size_t k = 0; k < jobs.size(); ++k)  // job k traced camera ray k
       if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) m_done[jobs[k].pixel] = 1;
     jobs.clear();
@@ -182,14 +195,9 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           Job& job = jobs.emplace_back();  // fields stored in place: a braced temporary is copied
           job.pixel = uint32_t(i);         // with one wide load of narrow stores, which stalls
           job.sample = s;
-          Sampler& rng = rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
-          if (pinhole) {
-            Vec2 sensor = sensor_sample(fx, fy_up, rng);
-            sensor_x.push_back(sensor.x);
-            sensor_y.push_back(sensor.y);
-          } else {
-            camera_ray(fx, fy_up, rng, camera_rays.emplace_back());  // in place: see spawn_ray
-          }
+          rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
+          sensor_x.push_back(float(fx));
+          sensor_y.push_back(float(fy_up));
         }
         if (jobs.size() >= kJobs) flush();
       }

@@ -128,7 +128,16 @@ class Sampler {
     else ++m_dim;
   }
 
+  // next_2d() of samplers s[0], ..., s[n - 1], bit for bit: the Sobol draws eight at a time in
+  // AVX2 lanes where the CPU has them (sampler_lanes.cpp), the rest one at a time. `lanes` false
+  // draws every one alone (for tests and comparisons).
+  static void next_2d_many(Sampler* s, size_t n, Vec2* out, bool lanes = true);
+  static void next_2d_many(Sampler* const* s, size_t n, Vec2* out, bool lanes = true);
+  // Whether next_2d_many draws in lanes on this CPU.
+  static bool lanes_available();
+
  private:
+  friend struct SamplerLanes;
   Pcg32& rng() {
     if (!m_rng) m_rng.emplace(make_sample_rng(m_seed, m_pixel, m_index));
     return *m_rng;

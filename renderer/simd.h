@@ -49,6 +49,19 @@ inline vf fabs(vf a) { return vf(vi(a) & 0x7fffffff); }
 inline vi is_finite(vf a) { return (vi(a) & 0x7f800000) != 0x7f800000; }
 inline vi is_black(V3 a) { return (a.x == 0) & (a.y == 0) & (a.z == 0); }
 inline vi all_finite(V3 a) { return is_finite(a.x) & is_finite(a.y) & is_finite(a.z); }
+// sample_concentric_disk (sampling.h) with sincos_quarter's polynomials (math.h).
+inline void concentric_disk(vf ux, vf uy, vf& x, vf& y) {
+  const vf one = splat(1.0f);
+  vf ox = splat(2.0f) * ux - one, oy = splat(2.0f) * uy - one;
+  vi wide = fabs(ox) > fabs(oy);
+  vf a = splat(kPi / 4) * sel(wide, oy / ox, ox / oy);
+  vf a2 = a * a;
+  vf s = a * (one + a2 * (splat(-1.0f / 6) + a2 * (splat(1.0f / 120) + a2 * splat(-1.0f / 5040))));
+  vf c = one + a2 * (splat(-0.5f) + a2 * (splat(1.0f / 24) + a2 * (splat(-1.0f / 720) + a2 * splat(1.0f / 40320))));
+  vi centre = (ox == 0) & (oy == 0);
+  x = sel(centre, vf{}, sel(wide, ox * c, oy * s));
+  y = sel(centre, vf{}, sel(wide, ox * s, oy * c));
+}
 inline vf max0(vf a) { return sel(vf{} < a, a, vf{}); }  // std::max(0.0f, a)
 
 }  // namespace pt::simd

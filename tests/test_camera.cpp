@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include "collada.h"
 #include "rng.h"
 #include "test_util.h"
@@ -244,6 +246,47 @@ TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
       EXPECT_EQ(lanes[i].d, one.d);
       EXPECT_EQ(lanes[i].tmin, one.tmin);
       EXPECT_EQ(lanes[i].tmax, one.tmax);
+    }
+  }
+}
+
+// generate_rays in lanes against generate_ray: a thin lens (and one focused at 0, where the lens
+// centre's ray falls back to the pinhole direction), lens samples at the disk map's centre and
+// edges, and a pinhole (which ignores the lens samples).
+TEST(Camera, ThinLensRaysInLanesAreGenerateRaysBits) {
+  SceneDesc s = box_scene();
+  CameraParams cp;
+  cp.width = 480;
+  cp.height = 360;
+  Camera c = make_camera(s, cp);
+  Frame tilted(normalize(Vec3(-0.6f, 0.2f, 0.7f)));
+  c.right = tilted.s, c.up = tilted.t, c.back = tilted.n;
+  Pcg32 rng(3, 5);
+  for (auto [radius, focus] : {std::pair{0.2f, 3.5f}, std::pair{0.3f, 0.0f}, std::pair{0.0f, 4.7f}}) {
+    c.lens_radius = radius, c.focal_distance = focus;
+    for (size_t n : {size_t(0), size_t(3), size_t(8), size_t(1001)}) {
+      std::vector<float> sx(n), sy(n);
+      std::vector<Vec2> lens(n);
+      for (size_t i = 0; i < n; ++i) {
+        sx[i] = 1.4f * rng.next_float() - 0.2f;
+        sy[i] = 1.4f * rng.next_float() - 0.2f;
+        lens[i] = rng.next_2d();
+      }
+      if (n > 7) {
+        lens[1] = {0.5f, 0.5f};  // the lens centre
+        lens[2] = {0, 0.5f}, lens[3] = {0.5f, 0.9999999f}, lens[4] = {0, 0};  // edges and a corner
+        lens[5] = {0.75f, 0.75f}, sx[5] = sy[5] = 0.5f;  // a diagonal, through the sensor centre
+      }
+      std::vector<Ray> lanes(n);
+      c.generate_rays(sx.data(), sy.data(), lens.data(), n, lanes.data());
+      for (size_t i = 0; i < n; ++i) {
+        Ray one = c.generate_ray(sx[i], sy[i], lens[i]);
+        SCOPED_TRACE(testing::Message() << "radius " << radius << " focus " << focus << " ray " << i);
+        ASSERT_EQ(std::memcmp(&lanes[i].o, &one.o, sizeof one.o), 0);
+        ASSERT_EQ(std::memcmp(&lanes[i].d, &one.d, sizeof one.d), 0);
+        ASSERT_EQ(lanes[i].tmin, one.tmin);
+        ASSERT_EQ(lanes[i].tmax, one.tmax);
+      }
     }
   }
 }

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <set>
 #include <vector>
 
@@ -548,4 +549,45 @@ TEST(Sampling, QuarterRangeSinCosMatchesTheLibraryAndTheDiskMapIsUnchanged) {
     ASSERT_NEAR(d.x, r * std::cos(theta), 1e-6);
     ASSERT_NEAR(d.y, r * std::sin(theta), 1e-6);
   }
+}
+
+// next_2d_many gives next_2d's numbers to each sampler, bit for bit, whatever their dimensions
+// (Sobol ones in lanes, the independent stream past them) and kinds, in any grouping.
+TEST(Sampler, ManyDrawsAtOnceAreEachSamplersOwnDraws) {
+  for (bool lanes : {false, true}) {
+    SCOPED_TRACE(lanes ? "lanes" : "one at a time");
+    std::vector<Sampler> mine, ref;
+    std::vector<int> skips;
+    for (uint32_t k = 0; k < 61; ++k) {  // not a multiple of 8: a partial group
+      SamplerKind kind = k % 13 == 5 ? SamplerKind::independent : SamplerKind::sobol;
+      mine.emplace_back(kind, 7 + k % 3, 1000 + k / 4, k * 977u);
+      ref.emplace_back(kind, 7 + k % 3, 1000 + k / 4, k * 977u);
+      skips.push_back(int(k % 11));  // some lanes past the Sobol dimensions
+    }
+    for (size_t k = 0; k < mine.size(); ++k)
+      for (int d = 0; d < skips[k]; ++d) mine[k].skip_1d(), ref[k].skip_1d();
+    std::vector<Sampler*> every_other;
+    for (size_t k = 0; k < mine.size(); k += 2) every_other.push_back(&mine[k]);
+    std::vector<Vec2> out(mine.size());
+    for (int round = 0; round < 6; ++round) {
+      if (round % 2 == 0) {
+        Sampler::next_2d_many(mine.data(), mine.size(), out.data(), lanes);
+        for (size_t k = 0; k < mine.size(); ++k) {
+          Vec2 want = ref[k].next_2d();
+          ASSERT_EQ(std::memcmp(&want, &out[k], sizeof want), 0) << "sampler " << k << " round " << round;
+        }
+      } else {
+        Sampler::next_2d_many(every_other.data(), every_other.size(), out.data(), lanes);
+        for (size_t k = 0; k < every_other.size(); ++k) {
+          Vec2 want = ref[2 * k].next_2d();
+          ASSERT_EQ(std::memcmp(&want, &out[k], sizeof want), 0) << "sampler " << 2 * k << " round " << round;
+        }
+      }
+    }
+    for (size_t k = 0; k < mine.size(); ++k) {  // and the draws after them follow on
+      float a = mine[k].next_float(), b = ref[k].next_float();
+      ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << "sampler " << k;
+    }
+  }
+  if (!Sampler::lanes_available()) GTEST_SKIP() << "no AVX2 here: only the one-at-a-time draws were checked";
 }
