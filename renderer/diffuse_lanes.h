@@ -1,8 +1,9 @@
-// The path loop's most common vertex, four paths at a time: a diffuse surface lit by area lights
+// The path loop's most common vertex, many paths at a time: a diffuse surface lit by area lights
 // (rectangles and emissive meshes), then a cosine-weighted bounce. The same arithmetic as the scalar
 // path_step (Frame, face_viewer, sample_light, diffuse_*, power_heuristic, spawn_ray*), operation
-// for operation, in SSE2 lanes: the images are bit-identical. The pool gathers its diffuse vertices
-// into these arrays, runs the lanes, and scatters the results back (integrator.cpp).
+// for operation, four at a time in SSE2 lanes or eight in AVX2 where the CPU has it: the images are
+// bit-identical. The pool gathers its diffuse vertices into these arrays, runs the lanes, and
+// scatters the results back (integrator.cpp).
 #pragma once
 
 #include <cstdint>
@@ -13,32 +14,32 @@ namespace pt::lanes {
 
 constexpr int kMaxLanes = 256;  // the pool's slots
 
-// Structure of arrays, one entry per vertex; the count is padded to a multiple of 4 by the caller.
+// Structure of arrays, one entry per vertex; the count is padded to a multiple of 8 by the caller.
 struct DiffuseVertices {
   // In: the hit, the arriving ray's direction, the path's throughput and its random numbers.
-  alignas(16) float px[kMaxLanes], py[kMaxLanes], pz[kMaxLanes];
-  alignas(16) float gx[kMaxLanes], gy[kMaxLanes], gz[kMaxLanes];  // geometric normal, as Embree's hit
-  alignas(16) float nx[kMaxLanes], ny[kMaxLanes], nz[kMaxLanes];  // shading normal
-  alignas(16) float offset[kMaxLanes];
-  alignas(16) float ax[kMaxLanes], ay[kMaxLanes], az[kMaxLanes];  // albedo
-  alignas(16) float dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes];  // arriving direction
-  alignas(16) float bx[kMaxLanes], by[kMaxLanes], bz[kMaxLanes];  // throughput, replaced by the bounce's
-  alignas(16) float ulx[kMaxLanes], uly[kMaxLanes];               // light sample (one light at a time)
-  alignas(16) float qx[kMaxLanes], qy[kMaxLanes], qz[kMaxLanes];  // or the point it picked on a mesh light
-  alignas(16) float lx[kMaxLanes], ly[kMaxLanes], lz[kMaxLanes];  // and the light's normal there
-  alignas(16) float ubx[kMaxLanes], uby[kMaxLanes];               // BSDF sample
-  alignas(16) float urr[kMaxLanes];                                // roulette; 2 where it is not played
+  alignas(32) float px[kMaxLanes], py[kMaxLanes], pz[kMaxLanes];
+  alignas(32) float gx[kMaxLanes], gy[kMaxLanes], gz[kMaxLanes];  // geometric normal, as Embree's hit
+  alignas(32) float nx[kMaxLanes], ny[kMaxLanes], nz[kMaxLanes];  // shading normal
+  alignas(32) float offset[kMaxLanes];
+  alignas(32) float ax[kMaxLanes], ay[kMaxLanes], az[kMaxLanes];  // albedo
+  alignas(32) float dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes];  // arriving direction
+  alignas(32) float bx[kMaxLanes], by[kMaxLanes], bz[kMaxLanes];  // throughput, replaced by the bounce's
+  alignas(32) float ulx[kMaxLanes], uly[kMaxLanes];               // light sample (one light at a time)
+  alignas(32) float qx[kMaxLanes], qy[kMaxLanes], qz[kMaxLanes];  // or the point it picked on a mesh light
+  alignas(32) float lx[kMaxLanes], ly[kMaxLanes], lz[kMaxLanes];  // and the light's normal there
+  alignas(32) float ubx[kMaxLanes], uby[kMaxLanes];               // BSDF sample
+  alignas(32) float urr[kMaxLanes];                                // roulette; 2 where it is not played
   // Out of light_pass: whether a shadow ray is needed, the ray, and what it carries if unblocked.
-  alignas(16) int shadow[kMaxLanes];
-  alignas(16) float sox[kMaxLanes], soy[kMaxLanes], soz[kMaxLanes];
-  alignas(16) float sdx[kMaxLanes], sdy[kMaxLanes], sdz[kMaxLanes];
-  alignas(16) float cx[kMaxLanes], cy[kMaxLanes], cz[kMaxLanes];
+  alignas(32) int shadow[kMaxLanes];
+  alignas(32) float sox[kMaxLanes], soy[kMaxLanes], soz[kMaxLanes];
+  alignas(32) float sdx[kMaxLanes], sdy[kMaxLanes], sdz[kMaxLanes];
+  alignas(32) float cx[kMaxLanes], cy[kMaxLanes], cz[kMaxLanes];
   // Out of bounce_pass: whether the path goes on, its next ray (from o along the next direction),
   // and the BSDF pdf.
-  alignas(16) int alive[kMaxLanes];
-  alignas(16) float ox[kMaxLanes], oy[kMaxLanes], oz[kMaxLanes];
-  alignas(16) float wx[kMaxLanes], wy[kMaxLanes], wz[kMaxLanes];
-  alignas(16) float pdf[kMaxLanes];
+  alignas(32) int alive[kMaxLanes];
+  alignas(32) float ox[kMaxLanes], oy[kMaxLanes], oz[kMaxLanes];
+  alignas(32) float wx[kMaxLanes], wy[kMaxLanes], wz[kMaxLanes];
+  alignas(32) float pdf[kMaxLanes];
 };
 
 // One of `samples` light samples per vertex from area light `light` (its color not black),
@@ -48,5 +49,10 @@ struct DiffuseVertices {
 void light_pass(DiffuseVertices& v, int n, const Light& light, int samples);
 // The cosine-weighted bounce, throughput update and Russian roulette for vertices [0, n).
 void bounce_pass(DiffuseVertices& v, int n);
+
+// The lanes' width: 8 where the CPU has AVX2 (and it is allowed), else 4. allow_avx2(false) keeps
+// them on SSE2, for tests and comparisons; it is not for use while a render runs.
+int lane_width();
+void allow_avx2(bool allow);
 
 }  // namespace pt::lanes

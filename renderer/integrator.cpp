@@ -284,7 +284,7 @@ struct PendingShadow {
 void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lanes::DiffuseVertices& v, const std::vector<uint32_t>& which,
                       std::vector<PoolSlot>& slots, Sampler* rngs, const SurfaceHit* hits, uint8_t* alive,
                       uint64_t& rays, std::vector<Ray>& shadow_rays, std::vector<PendingShadow>& shadows) {
-  const int n = int(which.size()), padded = (n + 3) & ~3;
+  const int n = int(which.size()), padded = (n + 7) & ~7;  // whole vectors of either width
   const size_t nl = scene.lights.size() * size_t(params.light_samples);  // draws, light by light
   static thread_local std::vector<Vec2> u_light, u;
   static thread_local std::vector<Sampler*> samplers;

@@ -154,7 +154,7 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
       sensor_y[k] = (sensor_y[k] + draws[k].y) / float(p.height);
     }
     if (lens) Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
-    camera_rays.resize(n);
+    if (camera_rays.size() < n) camera_rays.resize(n);  // kept between flushes: no zeroing
     m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
     sensor_x.clear();
     sensor_y.clear();
@@ -163,7 +163,6 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     for (size_t k = 0; k < jobs.size(); ++k)  // job k traced camera ray k
       if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) m_done[jobs[k].pixel] = 1;
     jobs.clear();
-    camera_rays.clear();
     rngs.clear();
     stopped = stop_requested(cancel);
   };

@@ -140,7 +140,11 @@ struct SamplerLanes {
     if (m == 0) return;
     for (size_t k = m; k < (m + kBlock - 1) / kBlock * kBlock; ++k) t.base[k] = t.index[k] = t.dim[k] = 0;  // padding
     sobol_lanes(t.base.data(), t.index.data(), t.dim.data(), m, t.u.data(), t.v.data());
-    for (size_t k = 0; k < m; ++k) out[t.which[k]] = {t.u[k], t.v[k]};
+    if (m == n) {  // the common case: every sampler in lanes
+      for (size_t k = 0; k < m; ++k) out[k] = {t.u[k], t.v[k]};
+    } else {
+      for (size_t k = 0; k < m; ++k) out[t.which[k]] = {t.u[k], t.v[k]};
+    }
   }
 };
 

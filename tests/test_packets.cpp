@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "collada.h"
+#include "diffuse_lanes.h"
 #include "render.h"
 #include "test_util.h"
 
@@ -104,20 +105,25 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
     if (c.path.empty()) test::area_lights_as_meshes(desc);  // sampled by triangle before the lanes
     RenderParams p = c.params;
     auto scene = make_render_scene(desc, p);
-    const bool lanes = diffuse_lanes_apply(*scene, p);
-    laned += lanes;
-    RenderSession with(*scene, p);
-    with.render_all();
-    p.simd_lanes = false;
-    EXPECT_FALSE(diffuse_lanes_apply(*scene, p));
-    RenderSession without(*scene, p);
+    laned += diffuse_lanes_apply(*scene, p);
+    RenderParams one = p;
+    one.simd_lanes = false;
+    EXPECT_FALSE(diffuse_lanes_apply(*scene, one));
+    RenderSession without(*scene, one);
     without.render_all();
-    ImageRGB a = with.image(), b = without.image();
-    ASSERT_EQ(a.pixels.size(), b.pixels.size());
-    EXPECT_EQ(differing_pixels(a, b), 0u);
-    EXPECT_EQ(with.stats().rays, without.stats().rays);
-    EXPECT_EQ(with.pixel_counts(), without.pixel_counts());
-    EXPECT_EQ(with.stats().nonfinite, 0u);
+    for (bool avx2 : {true, false}) {  // eight lanes where the CPU has AVX2, and four (SSE2)
+      lanes::allow_avx2(avx2);
+      SCOPED_TRACE(testing::Message() << lanes::lane_width() << " lanes");
+      RenderSession with(*scene, p);
+      with.render_all();
+      ImageRGB a = with.image(), b = without.image();
+      ASSERT_EQ(a.pixels.size(), b.pixels.size());
+      EXPECT_EQ(differing_pixels(a, b), 0u);
+      EXPECT_EQ(with.stats().rays, without.stats().rays);
+      EXPECT_EQ(with.pixel_counts(), without.pixel_counts());
+      EXPECT_EQ(with.stats().nonfinite, 0u);
+    }
+    lanes::allow_avx2(true);
   }
   EXPECT_GE(laned, 6) << "the own scenes' lights take the lanes: rectangles (1 or 3 samples), a mesh";
 }
