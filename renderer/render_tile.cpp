@@ -129,6 +129,11 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   std::vector<Ray> camera_rays;
   const bool lens = m_scene.camera.lens_radius > 0;
   std::vector<Sampler> rngs;
+  // With Sobol draws in lanes, the camera's draws come from each job's pixel base and sample index
+  // (Sampler::sobol_draws), and its sampler starts past them.
+  const bool sobol_lanes = p.simd_lanes && p.sampler == SamplerKind::sobol && Sampler::lanes_available();
+  const uint32_t camera_draws = (p.spp == 1 ? 0 : 1) + (lens ? 1 : 0);
+  std::vector<uint32_t> job_base, job_sample;
   std::vector<Vec3> out;
   // Each pixel's count before this pass, for the progress credit; kDone: finished before it.
   constexpr uint32_t kDone = ~0u;
@@ -146,6 +151,8 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     draws.resize(n);
     if (p.spp == 1) {  // sensor_sample: the pixel centre
       std::fill(draws.begin(), draws.end(), Vec2{0.5f, 0.5f});
+    } else if (sobol_lanes) {
+      Sampler::sobol_draws(job_base.data(), job_sample.data(), n, 1, draws.data());
     } else {
       Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
     }
@@ -153,7 +160,8 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
       sensor_x[k] = (sensor_x[k] + draws[k].x) / float(p.width);
       sensor_y[k] = (sensor_y[k] + draws[k].y) / float(p.height);
     }
-    if (lens) Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
+    if (lens && sobol_lanes) Sampler::sobol_draws(job_base.data(), job_sample.data(), n, camera_draws, draws.data());
+    else if (lens) Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
     if (camera_rays.size() < n) camera_rays.resize(n);  // kept between flushes: no zeroing
     m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
     sensor_x.clear();
@@ -164,6 +172,8 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
       if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) m_done[jobs[k].pixel] = 1;
     jobs.clear();
     rngs.clear();
+    job_base.clear();
+    job_sample.clear();
     stopped = stop_requested(cancel);
   };
   for (bool again = true; again && !stopped;) {
@@ -190,11 +200,17 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           if (stop) m_done[i] = 1;
           continue;
         }
+        const uint32_t base = Sampler::pixel_base(p.seed, pixel_index);
         for (uint32_t s = c; s < end; ++s) {
           Job& job = jobs.emplace_back();  // fields stored in place: a braced temporary is copied
           job.pixel = uint32_t(i);         // with one wide load of narrow stores, which stalls
           job.sample = s;
-          rngs.emplace_back(p.sampler, p.seed, pixel_index, m_first_sample + s);
+          const uint32_t index = m_first_sample + s;
+          rngs.emplace_back(p.sampler, p.seed, pixel_index, index, base, sobol_lanes ? camera_draws : 0);
+          if (sobol_lanes) {
+            job_base.push_back(base);
+            job_sample.push_back(index);
+          }
           sensor_x.push_back(float(fx));
           sensor_y.push_back(float(fy_up));
         }

@@ -101,8 +101,16 @@ class Sampler {
 
   // The independent stream is seeded on its first draw: most paths never get that far.
   Sampler(SamplerKind kind, uint64_t seed, uint64_t pixel, uint32_t sample)
-      : m_base(uint32_t(mix64(seed * 0x2545f4914f6cdd1dull + pixel))), m_index_reversed(reverse_bits32(sample)),
-        m_dim(kind == SamplerKind::independent ? kSobolDimensions : 0), m_seed(seed), m_pixel(pixel), m_index(sample) {}
+      : Sampler(kind, seed, pixel, sample, pixel_base(seed, pixel), 0) {}
+  // The same from the pixel's part of the state (pixel_base, computed once for all its samples),
+  // as it is after `drawn` 2D draws that the caller took for it (sobol_draws; Sobol only).
+  Sampler(SamplerKind kind, uint64_t seed, uint64_t pixel, uint32_t sample, uint32_t base, uint32_t drawn)
+      : m_base(base), m_index_reversed(reverse_bits32(sample)),
+        m_dim(kind == SamplerKind::independent ? kSobolDimensions : drawn), m_seed(seed), m_pixel(pixel),
+        m_index(sample) {}
+  static uint32_t pixel_base(uint64_t seed, uint64_t pixel) {
+    return uint32_t(mix64(seed * 0x2545f4914f6cdd1dull + pixel));
+  }
 
   // Burley 2020, listing 2, with the bit reversals that cancel taken out: the shuffled index is
   // i = reverse(j), sobol_dim0(i) = j, and nested_uniform_scramble(j) = reverse(lk(i)).
@@ -133,7 +141,11 @@ class Sampler {
   // draws every one alone (for tests and comparisons).
   static void next_2d_many(Sampler* s, size_t n, Vec2* out, bool lanes = true);
   static void next_2d_many(Sampler* const* s, size_t n, Vec2* out, bool lanes = true);
-  // Whether next_2d_many draws in lanes on this CPU.
+  // Draw number `draw` (1 for the first) of the fresh Sobol samplers (base[i], sample[i]), i < n,
+  // as their next_2d() would give it, without the samplers: for the camera's draws of many
+  // samples at once. Needs lanes_available().
+  static void sobol_draws(const uint32_t* base, const uint32_t* sample, size_t n, uint32_t draw, Vec2* out);
+  // Whether next_2d_many and sobol_draws draw in lanes on this CPU.
   static bool lanes_available();
 
  private:

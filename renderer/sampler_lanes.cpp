@@ -6,6 +6,7 @@
 // so without AVX2 the draws stay scalar. Integer arithmetic only: the lanes give next_2d's bits.
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <new>
 #include <vector>
@@ -114,6 +115,31 @@ __attribute__((target("avx2"))) static void sobol_lanes(const uint32_t* base, co
   }
 }
 
+static PT_AVX2 vu loadu(const uint32_t* a) {
+  vu x;
+  __builtin_memcpy(&x, a, sizeof x);
+  return x;
+}
+
+// Draw `draw` of fresh samplers from their bases and sample indices, for whole blocks of sixteen.
+__attribute__((target("avx2"))) static void sobol_lanes_fresh(const uint32_t* base, const uint32_t* sample,
+                                                              uint32_t draw, size_t n, Vec2* out) {
+  for (size_t i = 0; i < n; i += kBlock) {
+    vu seed[kGroups], j[kGroups], x[kGroups], y[kGroups];
+    for (size_t g = 0; g < kGroups; ++g) seed[g] = hash(loadu(base + i + 8 * g) + splat(0x9e3779b9u * draw));
+    for (size_t g = 0; g < kGroups; ++g) j[g] = laine_karras(reverse(loadu(sample + i + 8 * g)), seed[g]);
+    for (size_t g = 0; g < kGroups; ++g) {
+      const vu r = reverse(j[g]);
+      x[g] = laine_karras(r, seed[g] ^ splat(0xa511e9b3u));
+      y[g] = laine_karras(sobol_dim1_reversed_from_reversed(r), seed[g] ^ splat(0x63d83595u));
+    }
+    for (size_t g = 0; g < kGroups; ++g) {
+      const vf8 u = unit(reverse(x[g])), v = unit(reverse(y[g]));
+      for (size_t k = 0; k < 8; ++k) out[i + 8 * g + k] = {u[k], v[k]};
+    }
+  }
+}
+
 // Reads and writes the samplers' state for the lanes; a friend of Sampler.
 struct SamplerLanes {
   template <class At>
@@ -152,6 +178,18 @@ struct SamplerLanes {
     }
   }
 };
+
+void Sampler::sobol_draws(const uint32_t* base, const uint32_t* sample, size_t n, uint32_t draw, Vec2* out) {
+  const size_t whole = n / kBlock * kBlock;
+  sobol_lanes_fresh(base, sample, draw, whole, out);
+  if (whole == n) return;
+  uint32_t b[kBlock] = {}, s[kBlock] = {};  // the last, partial block, padded
+  Vec2 o[kBlock];
+  std::copy(base + whole, base + n, b);
+  std::copy(sample + whole, sample + n, s);
+  sobol_lanes_fresh(b, s, draw, kBlock, o);
+  std::copy(o, o + (n - whole), out + whole);
+}
 
 bool Sampler::lanes_available() {
   static const bool avx2 = __builtin_cpu_supports("avx2");

@@ -591,3 +591,33 @@ TEST(Sampler, ManyDrawsAtOnceAreEachSamplersOwnDraws) {
   }
   if (!Sampler::lanes_available()) GTEST_SKIP() << "no AVX2 here: only the one-at-a-time draws were checked";
 }
+
+// The camera's draws without samplers: sobol_draws from the pixel bases and sample indices gives
+// each sampler's first and second next_2d(), and a sampler built past them draws on as one that
+// took them itself.
+TEST(Sampler, CameraDrawsFromPixelBasesAreTheSamplersDraws) {
+  if (!Sampler::lanes_available()) GTEST_SKIP() << "no AVX2 here: sobol_draws needs it";
+  const size_t n = 37;  // two whole blocks of sixteen and a partial one
+  std::vector<uint32_t> base(n), sample(n);
+  std::vector<uint64_t> pixel(n);
+  for (size_t k = 0; k < n; ++k) {
+    pixel[k] = 5000 + k / 3;
+    sample[k] = uint32_t(k * 2654435761u);
+    base[k] = Sampler::pixel_base(11, pixel[k]);
+  }
+  std::vector<Vec2> first(n), second(n);
+  Sampler::sobol_draws(base.data(), sample.data(), n, 1, first.data());
+  Sampler::sobol_draws(base.data(), sample.data(), n, 2, second.data());
+  for (size_t k = 0; k < n; ++k) {
+    SCOPED_TRACE(k);
+    Sampler ref(SamplerKind::sobol, 11, pixel[k], sample[k]);
+    Vec2 a = ref.next_2d(), b = ref.next_2d();
+    EXPECT_EQ(std::memcmp(&a, &first[k], sizeof a), 0);
+    EXPECT_EQ(std::memcmp(&b, &second[k], sizeof b), 0);
+    Sampler past(SamplerKind::sobol, 11, pixel[k], sample[k], base[k], 2);
+    for (int d = 0; d < 8; ++d) {  // through the Sobol dimensions into the independent stream
+      Vec2 x = ref.next_2d(), y = past.next_2d();
+      ASSERT_EQ(std::memcmp(&x, &y, sizeof x), 0) << "draw " << d + 3;
+    }
+  }
+}
