@@ -383,15 +383,21 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   using Slot = PoolSlot;
   using Shadow = PendingShadow;
   const bool use_lanes = diffuse_lanes_apply(scene, params);
-  static thread_local std::unique_ptr<lanes::DiffuseVertices> lane_data;
-  if (use_lanes && !lane_data) lane_data = std::make_unique<lanes::DiffuseVertices>();
-  std::vector<uint32_t> in_lanes;
-  std::vector<Slot> slots(kSlots);
+  // The pool's arrays live on the thread between calls: a call per flush of a few thousand paths
+  // would otherwise zero some 60 KB each time.
+  struct Pool {
+    std::unique_ptr<lanes::DiffuseVertices> lane_data;
+    std::vector<uint32_t> in_lanes;
+    std::vector<Slot> slots = std::vector<Slot>(kSlots);
+    std::vector<Ray> ray_buf = std::vector<Ray>(kSlots), shadow_rays;
+    std::vector<SurfaceHit> hits = std::vector<SurfaceHit>(kSlots);
+    std::vector<uint8_t> found = std::vector<uint8_t>(kSlots), alive = std::vector<uint8_t>(kSlots), blocked;
+    std::vector<Shadow> shadows;
+  };
+  static thread_local Pool pool;
+  if (use_lanes && !pool.lane_data) pool.lane_data = std::make_unique<lanes::DiffuseVertices>();
+  auto& [lane_data, in_lanes, slots, ray_buf, shadow_rays, hits, found, alive, blocked, shadows] = pool;
   size_t live = 0;  // slots [0, live) hold paths
-  std::vector<Ray> ray_buf(kSlots), shadow_rays;
-  std::vector<SurfaceHit> hits(kSlots);
-  std::vector<uint8_t> found(kSlots), alive(kSlots), blocked;
-  std::vector<Shadow> shadows;
   size_t next = 0;
   for (;;) {
     for (; live < kSlots && next < n; ++live, ++next) {

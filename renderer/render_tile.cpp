@@ -134,6 +134,13 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   const bool sobol_lanes = p.simd_lanes && p.sampler == SamplerKind::sobol && Sampler::lanes_available();
   const uint32_t camera_draws = (p.spp == 1 ? 0 : 1) + (lens ? 1 : 0);
   std::vector<uint32_t> job_base, job_sample;
+  // A batch holds kJobs plus at most one pixel's samples: reserved once per tile, not grown.
+  const size_t most = kJobs + size_t(std::min(p.spp, 4096));
+  jobs.reserve(most);
+  rngs.reserve(most);
+  sensor_x.reserve(most);
+  sensor_y.reserve(most);
+  if (sobol_lanes) job_base.reserve(most), job_sample.reserve(most);
   std::vector<Vec3> out;
   // Each pixel's count before this pass, for the progress credit; kDone: finished before it.
   constexpr uint32_t kDone = ~0u;
