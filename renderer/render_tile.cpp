@@ -19,7 +19,8 @@ void RenderSession::camera_ray(int fx, int fy_up, Sampler& rng, Ray& r) const {
   cam.generate_ray(s.x, s.y, lens, r);
 }
 
-bool RenderSession::add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples, uint64_t& nonfinite) {
+__attribute__((always_inline)) inline bool RenderSession::add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples,
+                                                                     uint64_t& nonfinite) {
   if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
     ++nonfinite;
     l = Vec3(0.0f);
