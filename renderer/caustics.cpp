@@ -58,35 +58,33 @@ Vec3 sample_cone(const Cone& c, Vec2 u) {
 // Connects a non-delta vertex of the path to the camera (the pinhole, or the thin lens at the
 // point u_lens picks) and splats what the camera sees there. Light arrives along `arriving`
 // (pointing into the surface) with flux weight `beta`.
-void splat_to_camera(const RenderScene& scene, const CausticFilm& film, const SurfaceHit& hit,
-                     const Material& m, Vec3 arriving, Vec3 beta, Vec2 u_lens,
-                     std::vector<CausticSplat>& out, uint64_t& rays) {
+bool prepare_splat(const RenderScene& scene, const CausticFilm& film, const SurfaceHit& hit, const Material& m,
+                   Vec3 arriving, Vec3 beta, Vec2 u_lens, Ray& shadow, CausticSplat& splat) {
   const Camera& cam = scene.camera;
   float sx, sy;
   Vec3 eye;
-  if (!cam.sensor_point(hit.p, u_lens, sx, sy, eye)) return;
-  if (!(sx >= 0 && sx < 1 && sy >= 0 && sy < 1)) return;
+  if (!cam.sensor_point(hit.p, u_lens, sx, sy, eye)) return false;
+  if (!(sx >= 0 && sx < 1 && sy >= 0 && sy < 1)) return false;
   Vec3 v = hit.p - eye;
   float dist2 = length_squared(v), dist = std::sqrt(dist2);
   float z = -dot(v, cam.back);
-  if (!(dist > 0) || dist < cam.tmin || dist > cam.tmax) return;
+  if (!(dist > 0) || dist < cam.tmin || dist > cam.tmax) return false;
   int fx = std::min(int(sx * film.frame_w), film.frame_w - 1);
   int fy_up = std::min(int(sy * film.frame_h), film.frame_h - 1);
   int x = fx - film.x0, y = (film.frame_h - 1 - fy_up) - film.y0;
-  if (x < 0 || y < 0 || x >= film.w || y >= film.h) return;
+  if (x < 0 || y < 0 || x >= film.w || y >= film.h) return false;
 
   // The path tracer's shading frame at its first vertex: opaque, normals turned to the viewer.
   Vec3 wo_world = -v / dist, wi_world = -arriving;
   Vec3 ng = hit.ng, ns = hit.ns;
   face_viewer(wo_world, false, ng, ns);
   float cos_wi_g = dot(wi_world, ng), cos_wo_g = dot(wo_world, ng);
-  if (cos_wi_g <= 0 || cos_wo_g <= 0) return;  // the path tracer bounces on the viewer's side only
+  if (cos_wi_g <= 0 || cos_wo_g <= 0) return false;  // the path tracer bounces on the viewer's side only
   Frame frame(ns);
   Vec3 wi = frame.to_local(wi_world);
   Vec3 f = eval_bsdf(m, frame.to_local(wo_world), wi);
-  if (is_black(f)) return;
-  ++rays;
-  if (scene.accel->occluded(spawn_ray_to(hit, eye))) return;
+  if (is_black(f)) return false;
+  spawn_ray_to(hit, eye, shadow);  // the splat counts if nothing blocks it
 
   // Pixel value = W H / (4 tan_w tan_h) x the integral over visible area of L cos_x / (r^2 cos^3);
   // the flux estimate carries cos at the surface w.r.t. the true normal, the path tracer's
@@ -96,7 +94,9 @@ void splat_to_camera(const RenderScene& scene, const CausticFilm& film, const Su
   float cos_cam = z / dist;
   float k = float(film.frame_w) * float(film.frame_h) / (4 * cam.tan_half_w * cam.tan_half_h);
   Vec3 value = beta * f * (std::fabs(wi.z) / cos_wi_g * cos_wo_g * k / (dist2 * cos_cam * cos_cam * cos_cam));
-  if (is_finite(value) && !is_black(value)) out.push_back({uint32_t(size_t(y) * film.w + x), value});
+  if (!is_finite(value) || is_black(value)) return false;
+  splat = {uint32_t(size_t(y) * film.w + x), value};
+  return true;
 }
 
 }  // namespace
@@ -132,10 +132,24 @@ bool caustic_tracing_applies(const RenderScene& scene, const RenderParams& param
          !scene.caustic_targets.empty() && !scene.caustic_lights.empty();
 }
 
-void trace_caustic_path(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
-                        uint64_t index, std::vector<CausticSplat>& out, uint64_t& rays) {
-  Sampler rng(params.sampler, params.seed, kLightPathPixel + (index >> 32), uint32_t(index));
-  // A point on a light chosen by power, uniform by area.
+namespace {
+
+// A light path between its vertices: its random numbers, next ray and weights.
+struct LightPath {
+  Sampler rng{SamplerKind::independent, 0, 0, 0};  // set by start_light_path
+  Ray ray;
+  Vec3 beta, throughput{1.0f};
+  int delta_bounces = 0, diffuse_vertices = 0, vertex = 1;  // the next vertex, as the path tracer counts
+  uint32_t id = 0;                                          // its place among the call's paths
+};
+
+// Light path `index` up to its first ray: a point on a light chosen by power (uniform by area),
+// then a direction into the cone of one target, chosen in proportion to the cones' solid angles
+// (the pdf is the number of cones holding the direction over their total solid angle). False if
+// the path carries nothing.
+bool start_light_path(const RenderScene& scene, const RenderParams& params, uint64_t index, LightPath& lp) {
+  Sampler& rng = lp.rng;
+  rng = Sampler(params.sampler, params.seed, kLightPathPixel + (index >> 32), uint32_t(index));
   Vec2 u_light = rng.next_2d(), u_point = rng.next_2d();
   float p_light, u_reuse;
   size_t li = scene.caustic_light_distribution.sample_discrete(u_light.x, &p_light, &u_reuse);
@@ -143,8 +157,6 @@ void trace_caustic_path(const RenderScene& scene, const RenderParams& params, co
   Vec3 x0, n;
   sample_area_light_point(light, u_point, x0, n);
 
-  // A direction into the cone of one target, chosen in proportion to the cones' solid angles: the
-  // pdf is the number of cones holding the direction over their total solid angle.
   Cone cones[kMaxCausticTargets];
   size_t nt = scene.caustic_targets.size();
   float total = 0;
@@ -155,63 +167,142 @@ void trace_caustic_path(const RenderScene& scene, const RenderParams& params, co
   while (chosen + 1 < nt && pick >= cones[chosen].solid_angle) pick -= cones[chosen++].solid_angle;
   Vec3 wi = sample_cone(cones[chosen], u_dir);
   float cos_l = dot(wi, n);
-  if (!(cos_l > 0)) return;  // emitters are one-sided
+  if (!(cos_l > 0)) return false;  // emitters are one-sided
   int holding = 0;
   for (size_t k = 0; k < nt; ++k) holding += (k == chosen || dot(wi, cones[k].axis) >= cones[k].cos_max);
   float pdf_dir = float(holding) / total;
-  Vec3 beta = light.color * (cos_l * light.area / (p_light * pdf_dir));
-  if (!is_finite(beta)) return;
+  lp.beta = light.color * (cos_l * light.area / (p_light * pdf_dir));
+  if (!is_finite(lp.beta)) return false;
+  lp.ray.o = offset_ray_origin(x0, n);
+  lp.ray.d = wi;
+  lp.ray.tmin = 0;
+  lp.ray.tmax = kInf;
+  lp.throughput = Vec3(1.0f);
+  lp.delta_bounces = lp.diffuse_vertices = 0;
+  lp.vertex = 1;
+  return true;
+}
 
-  Ray ray;
-  ray.o = offset_ray_origin(x0, n);
-  ray.d = wi;
-  ray.tmin = 0;
-  ray.tmax = kInf;
-  Vec3 throughput(1.0f);
-  int delta_bounces = 0, diffuse_vertices = 0;
-  for (int vertex = 1;; ++vertex) {  // the path tracer's count: at most max_depth vertices
-    SurfaceHit hit;
-    ++rays;
-    if (!scene.accel->intersect(ray, hit)) return;
-    const Material& m = scene.materials[hit.material];
-    if (m.type == MaterialType::emission) return;  // emitters reflect nothing
-    const bool delta = is_delta(m);
-    // Ours are L S+ D+ E: a first non-delta vertex ends a path with no delta bounce, and a delta
-    // one after the diffuse part ends it too (the path tracer renders both).
-    if (delta ? diffuse_vertices > 0 : delta_bounces == 0) return;
-    if (!delta) {
-      Vec2 u_lens = scene.camera.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};
-      splat_to_camera(scene, film, hit, m, ray.d, beta, u_lens, out, rays);
-      ++diffuse_vertices;
-    } else {
-      ++delta_bounces;
-    }
-    if (vertex + 1 > params.max_depth) return;  // no room for another vertex
-    Vec3 wo_world = -ray.d, ng = hit.ng, ns = hit.ns;
-    bool transmissive = is_transmissive(m);
-    face_viewer(wo_world, transmissive, ng, ns);
-    Frame frame(ns);
-    float u_lobe = rng.next_float();
-    Vec2 u = rng.next_2d();
-    BsdfSample bs;
-    if (!sample_bsdf(m, frame.to_local(wo_world), u_lobe, u, bs)) return;
-    Vec3 wi_world = frame.to_world(bs.wi);
-    if (!transmissive && dot(wi_world, ng) <= 0) return;
-    // Importance transport through a shading normal (Veach 1997, eq. 5.19).
-    float den = std::fabs(dot(wo_world, ng)) * std::fabs(dot(wi_world, ns));
-    if (!(den > 0)) return;
-    float correction = std::fabs(dot(wo_world, ns)) * std::fabs(dot(wi_world, ng)) / den;
-    throughput *= bs.weight * correction;
-    beta *= bs.weight * correction;
-    if (is_black(beta) || !is_finite(beta)) return;
-    if (vertex >= kRouletteStart) {
-      float q = std::min(0.95f, max_component(throughput));
-      if (rng.next_float() >= q) return;
-      beta /= q;
-      throughput /= q;
-    }
-    ray = spawn_ray(hit, wi_world);
+// What a light path does with its ray's hit: a connection to the camera from a non-delta vertex
+// (its shadow ray and splat go to `connect`), then the BSDF bounce and roulette. False when the
+// path ends; otherwise lp.ray is the next ray.
+template <class Connect>
+bool light_path_step(const RenderScene& scene, const RenderParams& params, const CausticFilm& film, LightPath& lp,
+                     bool found, const SurfaceHit& hit, Connect&& connect) {
+  const int vertex = lp.vertex++;
+  if (!found) return false;
+  const Material& m = scene.materials[hit.material];
+  if (m.type == MaterialType::emission) return false;  // emitters reflect nothing
+  const bool delta = is_delta(m);
+  // Ours are L S+ D+ E: a first non-delta vertex ends a path with no delta bounce, and a delta
+  // one after the diffuse part ends it too (the path tracer renders both).
+  if (delta ? lp.diffuse_vertices > 0 : lp.delta_bounces == 0) return false;
+  Sampler& rng = lp.rng;
+  if (!delta) {
+    Vec2 u_lens = scene.camera.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};
+    Ray shadow;
+    CausticSplat splat;
+    if (prepare_splat(scene, film, hit, m, lp.ray.d, lp.beta, u_lens, shadow, splat)) connect(shadow, splat);
+    ++lp.diffuse_vertices;
+  } else {
+    ++lp.delta_bounces;
   }
+  if (vertex + 1 > params.max_depth) return false;  // no room for another vertex
+  Vec3 wo_world = -lp.ray.d, ng = hit.ng, ns = hit.ns;
+  bool transmissive = is_transmissive(m);
+  face_viewer(wo_world, transmissive, ng, ns);
+  Frame frame(ns);
+  float u_lobe = rng.next_float();
+  Vec2 u = rng.next_2d();
+  BsdfSample bs;
+  if (!sample_bsdf(m, frame.to_local(wo_world), u_lobe, u, bs)) return false;
+  Vec3 wi_world = frame.to_world(bs.wi);
+  if (!transmissive && dot(wi_world, ng) <= 0) return false;
+  // Importance transport through a shading normal (Veach 1997, eq. 5.19).
+  float den = std::fabs(dot(wo_world, ng)) * std::fabs(dot(wi_world, ns));
+  if (!(den > 0)) return false;
+  float correction = std::fabs(dot(wo_world, ns)) * std::fabs(dot(wi_world, ng)) / den;
+  lp.throughput *= bs.weight * correction;
+  lp.beta *= bs.weight * correction;
+  if (is_black(lp.beta) || !is_finite(lp.beta)) return false;
+  if (vertex >= kRouletteStart) {
+    float q = std::min(0.95f, max_component(lp.throughput));
+    if (rng.next_float() >= q) return false;
+    lp.beta /= q;
+    lp.throughput /= q;
+  }
+  spawn_ray(hit, wi_world, lp.ray);
+  return true;
+}
+
+}  // namespace
+
+void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
+                         uint64_t first, uint64_t count, std::vector<CausticSplat>& out, uint64_t& rays) {
+  // A pool of paths advances a vertex at a time, their rays traced together (Embree packets of 16
+  // unless --no-ray-packets), then their camera connections. Splats are kept in path order, as
+  // one path after another would make them, so the image does not depend on the pool.
+  constexpr size_t kSlots = 256;
+  struct Pool {
+    std::vector<LightPath> paths;
+    std::vector<Ray> rays, shadows;
+    std::vector<SurfaceHit> hits = std::vector<SurfaceHit>(kSlots);
+    std::vector<uint8_t> found = std::vector<uint8_t>(kSlots), blocked;
+    struct Pending {
+      uint32_t id;
+      CausticSplat splat;
+    };
+    std::vector<Pending> pending, made;
+  };
+  static thread_local Pool pool;
+  auto& [paths, ray_buf, shadows, hits, found, blocked, pending, made] = pool;
+  paths.clear();
+  made.clear();
+  uint64_t next = 0;
+  for (;;) {
+    while (paths.size() < kSlots && next < count) {
+      LightPath& lp = paths.emplace_back();
+      lp.id = uint32_t(next);
+      if (!start_light_path(scene, params, first + next++, lp)) paths.pop_back();
+    }
+    const size_t m = paths.size();
+    if (m == 0) break;
+    ray_buf.resize(m);
+    for (size_t i = 0; i < m; ++i) ray_buf[i] = paths[i].ray;
+    rays += m;
+    if (params.ray_packets) {
+      scene.accel->intersect_many(ray_buf.data(), m, hits.data(), found.data());
+    } else {
+      for (size_t i = 0; i < m; ++i) found[i] = scene.accel->intersect(ray_buf[i], hits[i]);
+    }
+    shadows.clear();
+    pending.clear();
+    size_t live = 0;
+    for (size_t i = 0; i < m; ++i) {
+      LightPath& lp = paths[i];
+      auto connect = [&](const Ray& shadow, const CausticSplat& splat) {
+        shadows.push_back(shadow);
+        pending.push_back({lp.id, splat});
+      };
+      if (light_path_step(scene, params, film, lp, found[i] != 0, hits[i], connect)) {
+        if (live != i) paths[live] = std::move(lp);
+        ++live;
+      }
+    }
+    paths.erase(paths.begin() + ptrdiff_t(live), paths.end());
+    blocked.resize(shadows.size());
+    rays += shadows.size();
+    if (params.ray_packets) {
+      scene.accel->occluded_many(shadows.data(), shadows.size(), blocked.data());
+    } else {
+      for (size_t k = 0; k < shadows.size(); ++k) blocked[k] = scene.accel->occluded(shadows[k]);
+    }
+    for (size_t k = 0; k < pending.size(); ++k)
+      if (!blocked[k]) made.push_back(pending[k]);
+  }
+  // Path order; a path's own splats are already in vertex order.
+  std::stable_sort(made.begin(), made.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  for (const auto& p : made) out.push_back(p.splat);
 }
 
 }  // namespace pt

@@ -53,9 +53,9 @@ struct CausticSplat {
   Vec3 value;      // to be divided by the number of light paths
 };
 
-// Traces light path `index` (its random numbers depend only on the seed and the index) and
-// appends the splats it makes. Counts its rays in `rays`.
-void trace_caustic_path(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
-                        uint64_t index, std::vector<CausticSplat>& out, uint64_t& rays);
+// Traces light paths [first, first + count) (their random numbers depend only on the seed and the
+// path's index) and appends their splats, in path order. Counts their rays in `rays`.
+void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
+                         uint64_t first, uint64_t count, std::vector<CausticSplat>& out, uint64_t& rays);
 
 }  // namespace pt

@@ -418,7 +418,7 @@ void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) 
       uint64_t rays = 0;
       for (size_t c; (c = next.fetch_add(1)) < in_wave && !stop_requested(cancel);) {
         uint64_t b = first + (wave + c) * kChunk, e = std::min(first + count, b + kChunk);
-        for (uint64_t i = b; i < e; ++i) trace_caustic_path(m_scene, m_params, m_caustic_film, i, splats[c], rays);
+        trace_caustic_paths(m_scene, m_params, m_caustic_film, b, e - b, splats[c], rays);
         finished[c] = 1;
       }
       m_rays += rays;

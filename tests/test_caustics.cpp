@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <memory>
 
+#include "caustics.h"
 #include "collada.h"
 #include "materials.h"
 #include "render.h"
@@ -156,6 +158,29 @@ TEST(Caustics, SameImageAtAnyThreadCount) {
   ASSERT_EQ(a.pixels.size(), b.pixels.size());
   for (size_t i = 0; i < a.pixels.size(); ++i) ASSERT_EQ(a.pixels[i], b.pixels[i]) << i;
   EXPECT_GT(one.stats().light_paths, 0u);
+}
+
+// The pool of light paths makes the splats that one path after another makes: the same splats in
+// path order, bit for bit (one-ray queries here, so the hits are the same), across refills.
+TEST(Caustics, PooledLightPathsSplatAsOnePathAtATime) {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  RenderParams p = cornell_params();
+  p.ray_packets = false;
+  auto scene = make_render_scene(desc, p);
+  ASSERT_TRUE(scene->features.caustic_tracing);
+  const CausticFilm film{p.width, p.height, 0, 0, p.width, p.height};
+  std::vector<CausticSplat> pooled, single;
+  uint64_t pooled_rays = 0, single_rays = 0;
+  const uint64_t first = 1000, count = 700;  // more paths than the pool's slots
+  trace_caustic_paths(*scene, p, film, first, count, pooled, pooled_rays);
+  for (uint64_t i = first; i < first + count; ++i) trace_caustic_paths(*scene, p, film, i, 1, single, single_rays);
+  ASSERT_GT(pooled.size(), 50u);
+  ASSERT_EQ(pooled.size(), single.size());
+  for (size_t k = 0; k < pooled.size(); ++k) {
+    ASSERT_EQ(pooled[k].pixel, single[k].pixel) << k;
+    ASSERT_EQ(std::memcmp(&pooled[k].value, &single[k].value, sizeof(Vec3)), 0) << k;
+  }
+  EXPECT_EQ(pooled_rays, single_rays);
 }
 
 TEST(Caustics, AppliesOnlyWhereItCan) {
