@@ -255,7 +255,15 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
     std::vector<Pending> pending, made;
   };
   static thread_local Pool pool;
-  auto& [paths, ray_buf, shadows, hits, found, blocked, pending, made] = pool;
+  // References, not a structured binding: C++17 lambdas cannot capture those (clang).
+  auto& paths = pool.paths;
+  auto& ray_buf = pool.rays;
+  auto& shadows = pool.shadows;
+  auto& hits = pool.hits;
+  auto& found = pool.found;
+  auto& blocked = pool.blocked;
+  auto& pending = pool.pending;
+  auto& made = pool.made;
   paths.clear();
   made.clear();
   uint64_t next = 0;

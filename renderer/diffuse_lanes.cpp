@@ -13,11 +13,16 @@ using namespace pt::simd;
 #include "diffuse_lanes_body.inc"
 }  // namespace pt::lanes::sse2
 
-// AVX2: eight lanes, for the CPUs that have it. Everything in this region is compiled for AVX2 and
+// AVX2: eight lanes, for the CPUs that have it. Everything in this region is compiled for AVX2 (a
+// target pragma for GCC, an attribute pragma for clang, which the sanitizer build uses) and
 // lives in its own namespaces, so no inline function of a header gets an AVX2 copy that the linker
 // could pick for the portable code. AVX2 without FMA: the same roundings as SSE2.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace pt::simd8 {
 #define PT_SIMD_WIDTH 8
 #include "simd_ops.inc"
@@ -27,7 +32,11 @@ namespace pt::lanes::avx2 {
 using namespace pt::simd8;
 #include "diffuse_lanes_body.inc"
 }  // namespace pt::lanes::avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 namespace pt::lanes {
 

@@ -396,7 +396,17 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   };
   static thread_local Pool pool;
   if (use_lanes && !pool.lane_data) pool.lane_data = std::make_unique<lanes::DiffuseVertices>();
-  auto& [lane_data, in_lanes, slots, ray_buf, shadow_rays, hits, found, alive, blocked, shadows] = pool;
+  // References, not a structured binding: C++17 lambdas cannot capture those (clang).
+  auto& lane_data = pool.lane_data;
+  auto& in_lanes = pool.in_lanes;
+  auto& slots = pool.slots;
+  auto& ray_buf = pool.ray_buf;
+  auto& shadow_rays = pool.shadow_rays;
+  auto& hits = pool.hits;
+  auto& found = pool.found;
+  auto& alive = pool.alive;
+  auto& blocked = pool.blocked;
+  auto& shadows = pool.shadows;
   size_t live = 0;  // slots [0, live) hold paths
   size_t next = 0;
   for (;;) {

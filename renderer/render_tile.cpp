@@ -143,7 +143,17 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     std::vector<uint32_t> before;
   };
   static thread_local Batch batch_arrays;
-  auto& [jobs, rngs, sensor_x, sensor_y, job_base, job_sample, draws, camera_rays, out, before] = batch_arrays;
+  // References, not a structured binding: C++17 lambdas cannot capture those (clang).
+  auto& jobs = batch_arrays.jobs;
+  auto& rngs = batch_arrays.rngs;
+  auto& sensor_x = batch_arrays.sensor_x;
+  auto& sensor_y = batch_arrays.sensor_y;
+  auto& job_base = batch_arrays.job_base;
+  auto& job_sample = batch_arrays.job_sample;
+  auto& draws = batch_arrays.draws;
+  auto& camera_rays = batch_arrays.camera_rays;
+  auto& out = batch_arrays.out;
+  auto& before = batch_arrays.before;
   jobs.clear();
   rngs.clear();
   sensor_x.clear();
