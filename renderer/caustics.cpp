@@ -213,7 +213,9 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
   face_viewer(wo_world, transmissive, ng, ns);
   Frame frame(ns);
   float u_lobe = rng.next_float();
-  Vec2 u = rng.next_2d();
+  Vec2 u;  // delta lobes need no direction sample: skipped, the draws after it stay the same
+  if (delta) rng.skip_2d();
+  else u = rng.next_2d();
   BsdfSample bs;
   if (!sample_bsdf(m, frame.to_local(wo_world), u_lobe, u, bs)) return false;
   Vec3 wi_world = frame.to_world(bs.wi);

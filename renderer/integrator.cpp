@@ -224,7 +224,9 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
   float u_lobe = 0;
   if (transmissive) u_lobe = rng.next_float();
   else rng.skip_1d();
-  Vec2 u = rng.next_2d();
+  Vec2 u;  // delta lobes need no direction sample: skipped, the draws after it stay the same
+  if (has_delta<F>(material)) rng.skip_2d();
+  else u = rng.next_2d();
   if (!sample_f<F>(material, v.wo, u_lobe, u, bs)) return false;
   Vec3 wi_world = v.frame.to_world(bs.wi);
   // Reflection must leave on the viewer's side of the true surface (no shading-normal leaks).

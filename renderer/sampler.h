@@ -135,6 +135,15 @@ class Sampler {
     if (m_dim >= kSobolDimensions) rng().next_u32();
     else ++m_dim;
   }
+  // The same for the pair next_2d() would return.
+  void skip_2d() {
+    if (m_dim >= kSobolDimensions) {
+      rng().next_u32();
+      rng().next_u32();
+    } else {
+      ++m_dim;
+    }
+  }
 
   // next_2d() of samplers s[0], ..., s[n - 1], bit for bit: the Sobol draws eight at a time in
   // AVX2 lanes where the CPU has them (sampler_lanes.cpp), the rest one at a time. `lanes` false

@@ -621,3 +621,20 @@ TEST(Sampler, CameraDrawsFromPixelBasesAreTheSamplersDraws) {
     }
   }
 }
+
+// skip_2d consumes what next_2d would: the draws after it are the same, in the Sobol dimensions,
+// past them, and in the independent stream.
+TEST(Sampler, SkippedPairLeavesTheLaterDrawsAsTheyWere) {
+  for (SamplerKind kind : {SamplerKind::sobol, SamplerKind::independent})
+    for (int before = 0; before < 10; ++before) {
+      Sampler a(kind, 5, 77, 1234), b(kind, 5, 77, 1234);
+      for (int d = 0; d < before; ++d) a.next_2d(), b.next_2d();
+      a.skip_2d();
+      b.next_2d();
+      for (int d = 0; d < 4; ++d) {
+        Vec2 x = a.next_2d(), y = b.next_2d();
+        ASSERT_EQ(std::memcmp(&x, &y, sizeof x), 0) << (kind == SamplerKind::sobol ? "sobol" : "independent")
+                                                    << " after " << before << " draws";
+      }
+    }
+}
