@@ -212,7 +212,9 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
   bool transmissive = is_transmissive(m);
   face_viewer(wo_world, transmissive, ng, ns);
   Frame frame(ns);
-  float u_lobe = rng.next_float();
+  float u_lobe = 0;  // only glass and refraction choose a lobe; the others skip that draw
+  if (transmissive) u_lobe = rng.next_float();
+  else rng.skip_1d();
   Vec2 u;  // delta lobes need no direction sample: skipped, the draws after it stay the same
   if (delta) rng.skip_2d();
   else u = rng.next_2d();
