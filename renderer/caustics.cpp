@@ -247,27 +247,16 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
   // unless --no-ray-packets), then their camera connections. Splats are kept in path order, as
   // one path after another would make them, so the image does not depend on the pool.
   constexpr size_t kSlots = 256;
-  struct Pool {
-    std::vector<LightPath> paths;
-    std::vector<Ray> rays, shadows;
-    std::vector<SurfaceHit> hits = std::vector<SurfaceHit>(kSlots);
-    std::vector<uint8_t> found = std::vector<uint8_t>(kSlots), blocked;
-    struct Pending {
-      uint32_t id;
-      CausticSplat splat;
-    };
-    std::vector<Pending> pending, made;
+  struct Pending {
+    uint32_t id;
+    CausticSplat splat;
   };
-  static thread_local Pool pool;
-  // References, not a structured binding: C++17 lambdas cannot capture those (clang).
-  auto& paths = pool.paths;
-  auto& ray_buf = pool.rays;
-  auto& shadows = pool.shadows;
-  auto& hits = pool.hits;
-  auto& found = pool.found;
-  auto& blocked = pool.blocked;
-  auto& pending = pool.pending;
-  auto& made = pool.made;
+  // Kept on the thread from call to call (one call per chunk of paths).
+  static thread_local std::vector<LightPath> paths;
+  static thread_local std::vector<Ray> ray_buf, shadows;
+  static thread_local std::vector<SurfaceHit> hits(kSlots);
+  static thread_local std::vector<uint8_t> found(kSlots), blocked;
+  static thread_local std::vector<Pending> pending, made;
   paths.clear();
   made.clear();
   uint64_t next = 0;

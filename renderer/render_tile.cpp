@@ -130,30 +130,16 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   struct Job {
     uint32_t pixel, sample;
   };
-  struct Batch {
-    std::vector<Job> jobs;
-    std::vector<Sampler> rngs;
-    // Camera rays are made at the flush: each job's pixel corner, then its sensor and lens draws
-    // for all jobs at once, then the rays four at a time (generate_rays).
-    std::vector<float> sensor_x, sensor_y;
-    std::vector<uint32_t> job_base, job_sample;
-    std::vector<Vec2> draws;
-    std::vector<Ray> camera_rays;
-    std::vector<Vec3> out;
-    std::vector<uint32_t> before;
-  };
-  static thread_local Batch batch_arrays;
-  // References, not a structured binding: C++17 lambdas cannot capture those (clang).
-  auto& jobs = batch_arrays.jobs;
-  auto& rngs = batch_arrays.rngs;
-  auto& sensor_x = batch_arrays.sensor_x;
-  auto& sensor_y = batch_arrays.sensor_y;
-  auto& job_base = batch_arrays.job_base;
-  auto& job_sample = batch_arrays.job_sample;
-  auto& draws = batch_arrays.draws;
-  auto& camera_rays = batch_arrays.camera_rays;
-  auto& out = batch_arrays.out;
-  auto& before = batch_arrays.before;
+  static thread_local std::vector<Job> jobs;
+  static thread_local std::vector<Sampler> rngs;
+  // Camera rays are made at the flush: each job's pixel corner, then its sensor and lens draws for
+  // all jobs at once, then the rays four at a time (generate_rays).
+  static thread_local std::vector<float> sensor_x, sensor_y;
+  static thread_local std::vector<uint32_t> job_base, job_sample;
+  static thread_local std::vector<Vec2> draws;
+  static thread_local std::vector<Ray> camera_rays;
+  static thread_local std::vector<Vec3> out;
+  static thread_local std::vector<uint32_t> before;
   jobs.clear();
   rngs.clear();
   sensor_x.clear();

@@ -219,16 +219,22 @@ TEST(Camera, KeepFovScalesTheCourseViewInsteadOfCropping) {
   EXPECT_NEAR(cropped.tan_half_w, full.tan_half_w * 0.6f, 1e-6);
 }
 
-// Camera rays four at a time (render_tile's pinhole batches) must be pinhole_ray's bits, for any
-// count (the tail of fewer than four goes one by one) and sensor points on and off the sensor.
-TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
-  SceneDesc s = box_scene();
+// A 480x360 course camera turned so that every axis mixes x, y and z: the lanes' sums must run in
+// the scalar order to give its bits.
+Camera tilted_camera(Vec3 back) {
   CameraParams cp;
   cp.width = 480;
   cp.height = 360;
-  Camera c = make_camera(s, cp);
-  Frame tilted(normalize(Vec3(0.3f, -0.5f, 0.8f)));  // every axis mixes x, y and z: sums in order
+  Camera c = make_camera(box_scene(), cp);
+  Frame tilted(normalize(back));
   c.right = tilted.s, c.up = tilted.t, c.back = tilted.n;
+  return c;
+}
+
+// Camera rays four at a time (render_tile's pinhole batches) must be pinhole_ray's bits, for any
+// count (the tail of fewer than four goes one by one) and sensor points on and off the sensor.
+TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
+  Camera c = tilted_camera(Vec3(0.3f, -0.5f, 0.8f));
   Pcg32 rng(7, 11);
   for (size_t n : {size_t(0), size_t(1), size_t(4), size_t(7), size_t(1001)}) {
     std::vector<float> sx(n), sy(n);
@@ -254,13 +260,7 @@ TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
 // centre's ray falls back to the pinhole direction), lens samples at the disk map's centre and
 // edges, and a pinhole (which ignores the lens samples).
 TEST(Camera, ThinLensRaysInLanesAreGenerateRaysBits) {
-  SceneDesc s = box_scene();
-  CameraParams cp;
-  cp.width = 480;
-  cp.height = 360;
-  Camera c = make_camera(s, cp);
-  Frame tilted(normalize(Vec3(-0.6f, 0.2f, 0.7f)));
-  c.right = tilted.s, c.up = tilted.t, c.back = tilted.n;
+  Camera c = tilted_camera(Vec3(-0.6f, 0.2f, 0.7f));
   Pcg32 rng(3, 5);
   for (auto [radius, focus] : {std::pair{0.2f, 3.5f}, std::pair{0.3f, 0.0f}, std::pair{0.0f, 4.7f}}) {
     c.lens_radius = radius, c.focal_distance = focus;
