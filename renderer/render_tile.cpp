@@ -140,12 +140,15 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   static thread_local std::vector<Ray> camera_rays;
   static thread_local std::vector<Vec3> out;
   static thread_local std::vector<uint32_t> before;
-  jobs.clear();
-  rngs.clear();
-  sensor_x.clear();
-  sensor_y.clear();
-  job_base.clear();
-  job_sample.clear();
+  auto clear_batch = [&] {
+    jobs.clear();
+    rngs.clear();
+    sensor_x.clear();
+    sensor_y.clear();
+    job_base.clear();
+    job_sample.clear();
+  };
+  clear_batch();
   // Each pixel's count before this pass, for the progress credit; kDone: finished before it.
   constexpr uint32_t kDone = ~0u;
   const int tw = t.x1 - t.x0;
@@ -175,16 +178,11 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     else if (lens) Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
     if (camera_rays.size() < n) camera_rays.resize(n);  // kept between flushes: no zeroing
     m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
-    sensor_x.clear();
-    sensor_y.clear();
     out.resize(n);
     if (n) trace(m_scene, p, camera_rays.data(), rngs.data(), n, out.data(), rays);
     for (size_t k = 0; k < jobs.size(); ++k)  // job k traced camera ray k
       if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) m_done[jobs[k].pixel] = 1;
-    jobs.clear();
-    rngs.clear();
-    job_base.clear();
-    job_sample.clear();
+    clear_batch();
     stopped = stop_requested(cancel);
   };
   for (bool again = true; again && !stopped;) {
