@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "collada.h"
+#include "diffuse_lanes.h"
 #include "progress.h"
 #include "render.h"
 #include "viewer.h"
@@ -39,13 +40,13 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
               f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
   std::printf("ray queries:      %s\n",
               o.params.ray_packets && !o.params.hemisphere ? "paths in packets of 16" : "one path at a time");
-  std::printf("diffuse vertices: %s\n",
-              o.params.ray_packets && diffuse_lanes_apply(scene, o.params) ? "four at a time (SSE2 lanes)" : "one at a time");
   const bool packets = o.params.ray_packets && !o.params.hemisphere;
-  std::printf("sample draws:     %s\n", packets && o.params.simd_lanes && o.params.sampler == SamplerKind::sobol &&
-                                             Sampler::lanes_available()
-                                         ? "eight at a time (AVX2 lanes)"
-                                         : "one at a time");
+  const char* diffuse = !(packets && diffuse_lanes_apply(scene, o.params)) ? "one at a time"
+                        : lanes::lane_width() == 8                        ? "eight at a time (AVX2 lanes)"
+                                                                          : "four at a time (SSE2 lanes)";
+  std::printf("diffuse vertices: %s\n", diffuse);
+  std::printf("sample draws:     %s\n",
+              packets && sobol_draws_in_lanes(o.params) ? "eight at a time (AVX2 lanes)" : "one at a time");
   std::printf("render memory:    %.2f MiB (%.1f bytes per primitive: BVH, vertices, indices, shading data)\n",
               bytes / 1048576.0, prims ? double(bytes) / prims : 0.0);
   std::printf("load + build:     %.3f s\n", load_s);

@@ -136,6 +136,9 @@ PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const RenderParams&
 // Whether the batched loop takes its diffuse vertices four at a time in SSE2 lanes
 // (diffuse_lanes.h): packets, every light an area light (rectangle or mesh), and not --no-simd-lanes.
 bool diffuse_lanes_apply(const RenderScene& scene, const RenderParams& params);
+// Whether packets take their Sobol draws eight at a time (Sampler::next_2d_many / sobol_draws):
+// the Sobol sampler, lanes not turned off, and a CPU with AVX2.
+bool sobol_draws_in_lanes(const RenderParams& params);
 
 // The course's adaptive-sampling test for one pixel with n > 1 luminance samples of sum s1 and
 // sum of squares s2: the 95% confidence half-width is within tolerance x mean. Shared by the

@@ -6,6 +6,10 @@
 
 namespace pt {
 
+bool sobol_draws_in_lanes(const RenderParams& params) {
+  return params.simd_lanes && params.sampler == SamplerKind::sobol && Sampler::lanes_available();
+}
+
 Vec2 RenderSession::sensor_sample(int fx, int fy_up, Sampler& rng) const {
   const RenderParams& p = m_params;
   Vec2 jitter = p.spp == 1 ? Vec2{0.5f, 0.5f} : rng.next_2d();  // -s 1: the pixel centre
@@ -123,7 +127,7 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   const bool lens = m_scene.camera.lens_radius > 0;
   // With Sobol draws in lanes, the camera's draws come from each job's pixel base and sample index
   // (Sampler::sobol_draws), and its sampler starts past them.
-  const bool sobol_lanes = p.simd_lanes && p.sampler == SamplerKind::sobol && Sampler::lanes_available();
+  const bool sobol_lanes = sobol_draws_in_lanes(p);
   const uint32_t camera_draws = (p.spp == 1 ? 0 : 1) + (lens ? 1 : 0);
   // The batch's arrays, kept on the thread from tile to tile: allocated per tile they cost some
   // 150 KB of fresh pages each time, about 5 ms of a pass (dof, 16 spp).

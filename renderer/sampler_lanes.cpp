@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "sampler.h"
+#include "simd.h"
 
 namespace pt {
 
@@ -191,10 +192,7 @@ void Sampler::sobol_draws(const uint32_t* base, const uint32_t* sample, size_t n
   std::copy(o, o + (n - whole), out + whole);
 }
 
-bool Sampler::lanes_available() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-}
+bool Sampler::lanes_available() { return simd::avx2_available(); }
 
 void Sampler::next_2d_many(Sampler* s, size_t n, Vec2* out, bool lanes) {
   SamplerLanes::draw([s](size_t i) -> Sampler& { return s[i]; }, n, out, lanes);
