@@ -115,13 +115,16 @@ inline Ray spawn_ray(const SurfaceHit& hit, Vec3 d) {
   spawn_ray(hit, d, r);
   return r;
 }
+// Where a shadow ray from spawn_ray_to ends, as a fraction of the way to its target: short of the
+// target surface itself.
+constexpr float kShadowRayEnd = 1 - 1e-4f;
 // A shadow ray from the surface to a point on another surface (target excluded).
 inline void spawn_ray_to(const SurfaceHit& hit, Vec3 target, Ray& r) {
   Vec3 n = dot(target - hit.p, hit.ng) >= 0 ? hit.ng : -hit.ng;
   r.o = offset_ray_origin(hit.p + n * hit.offset, n);
   r.d = target - r.o;
   r.tmin = 0;
-  r.tmax = 1 - 1e-4f;  // stop short of the target surface itself
+  r.tmax = kShadowRayEnd;
 }
 inline Ray spawn_ray_to(const SurfaceHit& hit, Vec3 target) {
   Ray r;

@@ -121,21 +121,22 @@ Vec3 direct_hemisphere(const RenderScene& scene, const RenderParams& params, con
 
 // One camera path between ray queries: the ray to trace next, what it has gathered so far, and
 // the light sampling of its current vertex until that vertex's shadow rays are answered.
+// Its starting values are set in one place, start().
 struct PathState {
   Ray ray;
-  Vec3 radiance{0.0f}, beta{1.0f};
-  Vec3 direct_beta{0.0f}, direct_sum{0.0f};  // radiance += direct_beta * direct_sum once resolved
-  bool has_direct = false;
-  bool specular = true;  // the camera ray counts as specular: emitters it sees get full weight
+  Vec3 radiance, beta;
+  Vec3 direct_beta, direct_sum;  // radiance += direct_beta * direct_sum once resolved
+  bool has_direct;
+  bool specular;  // the camera ray counts as specular: emitters it sees get full weight
   // Where the path stands against the light tracer's share (caustics.h), paths E D+ S+ L: non-delta
   // vertices only so far (1), then delta bounces only (2), or neither (0).
-  int caustic_phase = 0;
-  float prev_pdf = 0;
+  int caustic_phase;
+  float prev_pdf;
   Vec3 prev_p;
-  int depth_left = 0;
-  int bounce = 0;
+  int depth_left;
+  int bounce;
 
-  PathState() = default;
+  PathState() { start(Ray(), 0); }
   PathState(const Ray& camera_ray, int max_depth) { start(camera_ray, max_depth); }
   // Every field set in place (a pool slot takes its next path here; see spawn_ray in accel.h).
   void start(const Ray& camera_ray, int max_depth) {
@@ -280,8 +281,8 @@ struct PendingShadow {
   Vec3 contribution;
 };
 
-// path_step for the pool's slots `which`, all of them at a diffuse hit with depth left, in SSE2
-// lanes: the draws in path_step's order (light samples, the unused lobe number, the bounce,
+// path_step for the pool's slots `which`, all of them at a diffuse hit with depth left, in lanes
+// (diffuse_lanes.h): the draws in path_step's order (light samples, the unused lobe number, the bounce,
 // roulette), light passes light by light, the bounce. The same bits as path_step.
 void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lanes::DiffuseVertices& v, const std::vector<uint32_t>& which,
                       std::vector<PoolSlot>& slots, Sampler* rngs, const SurfaceHit* hits, uint8_t* alive,
@@ -348,7 +349,7 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
       r.o = Vec3(v.sox[j], v.soy[j], v.soz[j]);
       r.d = Vec3(v.sdx[j], v.sdy[j], v.sdz[j]);
       r.tmin = 0;
-      r.tmax = 1 - 1e-4f;  // as spawn_ray_to
+      r.tmax = kShadowRayEnd;  // as spawn_ray_to
       PendingShadow& s = shadows[k++];
       s.slot = which[size_t(j)];
       s.contribution = Vec3(v.cx[j], v.cy[j], v.cz[j]);
