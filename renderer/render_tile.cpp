@@ -52,6 +52,15 @@ __attribute__((always_inline)) inline bool RenderSession::add_sample(size_t i, u
 uint32_t RenderSession::add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stopped) {
   const uint32_t batch = uint32_t(std::max(1, m_params.adaptive_batch));
   stopped = false;
+  if (!m_params.adaptive && from < to) {  // no stop test: only the last power of two in [from, to) is kept
+    const uint32_t last = 1u << (31 - __builtin_clz((to - 1) | 1));  // the largest power of two <= max(to - 1, 1)
+    if (to > 1 && last >= from) {
+      m_half_s1[i] = m_s1[i];
+      m_half_n[i] = last;
+    }
+    m_count[i] = to;
+    return to - from;
+  }
   uint32_t s = from;
   while (s < to) {
     if (s > 0 && (s & (s - 1)) == 0) {
@@ -144,15 +153,18 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   static thread_local std::vector<Ray> camera_rays;
   static thread_local std::vector<Vec3> out;
   static thread_local std::vector<uint32_t> before;
-  auto clear_batch = [&] {
-    jobs.clear();
-    rngs.clear();
-    sensor_x.clear();
-    sensor_y.clear();
-    job_base.clear();
-    job_sample.clear();
-  };
-  clear_batch();
+  // The job arrays are written by index up to `njobs`: sized once per tile for a full batch plus
+  // one pixel's samples, which push_back's capacity checks would otherwise test at every store.
+  const size_t capacity = kJobs + size_t(std::max(target, 1));
+  if (jobs.size() < capacity) {
+    jobs.resize(capacity);
+    rngs.resize(capacity, Sampler(p.sampler, p.seed, 0, 0));
+    sensor_x.resize(capacity);
+    sensor_y.resize(capacity);
+    job_base.resize(capacity);
+    job_sample.resize(capacity);
+  }
+  size_t njobs = 0;
   // Each pixel's count before this pass, for the progress credit; kDone: finished before it.
   constexpr uint32_t kDone = ~0u;
   const int tw = t.x1 - t.x0;
@@ -165,7 +177,7 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
 
   bool stopped = false;
   auto flush = [&] {
-    const size_t n = jobs.size();
+    const size_t n = njobs;
     draws.resize(n);
     if (p.spp == 1) {  // sensor_sample: the pixel centre
       std::fill(draws.begin(), draws.end(), Vec2{0.5f, 0.5f});
@@ -184,9 +196,9 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
     out.resize(n);
     if (n) trace(m_scene, p, camera_rays.data(), rngs.data(), n, out.data(), rays);
-    for (size_t k = 0; k < jobs.size(); ++k)  // job k traced camera ray k
+    for (size_t k = 0; k < n; ++k)  // job k traced camera ray k
       if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) m_done[jobs[k].pixel] = 1;
-    clear_batch();
+    njobs = 0;
     stopped = stop_requested(cancel);
   };
   for (bool again = true; again && !stopped;) {
@@ -214,23 +226,21 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           continue;
         }
         const uint32_t base = Sampler::pixel_base(p.seed, pixel_index);
-        for (uint32_t s = c; s < end; ++s) {
-          Job& job = jobs.emplace_back();  // fields stored in place: a braced temporary is copied
-          job.pixel = uint32_t(i);         // with one wide load of narrow stores, which stalls
+        for (uint32_t s = c; s < end; ++s, ++njobs) {
+          Job& job = jobs[njobs];  // fields stored one by one: a braced temporary is copied
+          job.pixel = uint32_t(i);  // with one wide load of narrow stores, which stalls
           job.sample = s;
           const uint32_t index = m_first_sample + s;
-          rngs.emplace_back(p.sampler, p.seed, pixel_index, index, base, sobol_lanes ? camera_draws : 0);
-          if (sobol_lanes) {
-            job_base.push_back(base);
-            job_sample.push_back(index);
-          }
-          sensor_x.push_back(float(fx));
-          sensor_y.push_back(float(fy_up));
+          rngs[njobs] = Sampler(p.sampler, p.seed, pixel_index, index, base, sobol_lanes ? camera_draws : 0);
+          job_base[njobs] = base;
+          job_sample[njobs] = index;
+          sensor_x[njobs] = float(fx);
+          sensor_y[njobs] = float(fy_up);
         }
-        if (jobs.size() >= kJobs) flush();
+        if (njobs >= kJobs) flush();
       }
     }
-    if (!jobs.empty()) flush();
+    if (njobs) flush();
   }
   // The tile's progress credit in one update: the counter is shared by the threads, and an atomic
   // add per pixel would move its cache line between cores a thousand times a tile.

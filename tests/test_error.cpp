@@ -103,3 +103,35 @@ TEST(ErrorEstimateDenominator, FireflyUsesItsNeighbourhoodBrightEdgeKeepsItsOwnM
   double edge_var = 0.4 * 0.4 * p * (n - p) / double(n * n);
   EXPECT_NEAR(edge - quiet, edge_var / (10.0 * 10.0 + kRelMseEpsilon) / (w * h) - quiet / (w * h), 1e-8);
 }
+
+// Pixels that see only background add their samples as zeros in one step (add_zero_samples);
+// they still keep the halves the estimate compares. A frame of background only is exactly black
+// and converged: its estimate is unknown after one sample (INFINITY) and 0 from two on.
+TEST(ErrorEstimateBackground, AFrameOfBackgroundOnlyIsConvergedFromTwoSamples) {
+  SceneDesc d;
+  d.materials.resize(1);
+  d.spheres.push_back({"aside", Vec3(50, 0, -5), 1.0f, 0});  // in front (-z) but far out of view
+  d.camera.present = true;
+  for (bool packets : {true, false})
+    for (float lens : {0.0f, 0.05f}) {
+      RenderParams p;
+      p.file_camera = true;
+      p.width = 24;
+      p.height = 16;
+      p.adaptive = false;
+      p.spp = 16;
+      p.ray_packets = packets;
+      p.lens_radius = lens;
+      p.focal_distance = 2;
+      auto scene = make_render_scene(d, p);
+      RenderSession s(*scene, p);
+      for (int fy = 0; fy < p.height; ++fy)
+        for (int fx = 0; fx < p.width; ++fx) ASSERT_TRUE(s.sees_only_background(fx, fy)) << fx << " " << fy;
+      for (int target = 1; target <= p.spp; target *= 2) {
+        s.render_pass(target);
+        if (target == 1) EXPECT_EQ(s.error_estimate(), INFINITY) << "packets " << packets << ", lens " << lens;
+        else EXPECT_EQ(s.error_estimate(), 0.0) << target << " spp, packets " << packets << ", lens " << lens;
+      }
+      EXPECT_EQ(s.stats().samples, uint64_t(p.width) * p.height * p.spp);
+    }
+}
