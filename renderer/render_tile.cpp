@@ -152,7 +152,6 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   static thread_local std::vector<Vec2> draws;
   static thread_local std::vector<Ray> camera_rays;
   static thread_local std::vector<Vec3> out;
-  static thread_local std::vector<uint32_t> before;
   // The job arrays are written by index up to `njobs`: sized once per tile for a full batch plus
   // one pixel's samples, which push_back's capacity checks would otherwise test at every store.
   const size_t capacity = kJobs + size_t(std::max(target, 1));
@@ -165,15 +164,10 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     job_sample.resize(capacity);
   }
   size_t njobs = 0;
-  // Each pixel's count before this pass, for the progress credit; kDone: finished before it.
-  constexpr uint32_t kDone = ~0u;
-  const int tw = t.x1 - t.x0;
-  before.resize(size_t(tw) * (t.y1 - t.y0));
-  for (int y = t.y0; y < t.y1; ++y)
-    for (int x = t.x0; x < t.x1; ++x) {
-      size_t i = size_t(y) * m_w + x;
-      before[size_t(y - t.y0) * tw + (x - t.x0)] = m_done[i] ? kDone : m_count[i];
-    }
+  // The tile's progress credit: every sample added, and the rest of a pixel's budget when an
+  // adaptive stop ends it here.
+  const uint64_t samples_before = samples;
+  uint64_t stopped_credit = 0;
 
   bool stopped = false;
   auto flush = [&] {
@@ -197,7 +191,10 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     out.resize(n);
     if (n) trace(m_scene, p, camera_rays.data(), rngs.data(), n, out.data(), rays);
     for (size_t k = 0; k < n; ++k)  // job k traced camera ray k
-      if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) m_done[jobs[k].pixel] = 1;
+      if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) {
+        m_done[jobs[k].pixel] = 1;
+        stopped_credit += uint64_t(p.spp) - m_count[jobs[k].pixel];
+      }
     njobs = 0;
     stopped = stop_requested(cancel);
   };
@@ -222,7 +219,10 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           uint32_t added = add_zero_samples(i, c, end, stop);
           rays += added;
           samples += added;
-          if (stop) m_done[i] = 1;
+          if (stop) {
+            m_done[i] = 1;
+            stopped_credit += uint64_t(p.spp) - m_count[i];
+          }
           continue;
         }
         const uint32_t base = Sampler::pixel_base(p.seed, pixel_index);
@@ -242,17 +242,14 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     }
     if (njobs) flush();
   }
-  // The tile's progress credit in one update: the counter is shared by the threads, and an atomic
-  // add per pixel would move its cache line between cores a thousand times a tile.
-  uint64_t credit = 0;
   for (int y = t.y0; y < t.y1; ++y)
     for (int x = t.x0; x < t.x1; ++x) {
       size_t i = size_t(y) * m_w + x;
       if (m_count[i] >= uint32_t(p.spp)) m_done[i] = 1;
-      uint32_t b = before[size_t(y - t.y0) * tw + (x - t.x0)];
-      if (b == kDone) continue;
-      credit += m_done[i] ? uint64_t(p.spp) - b : uint64_t(m_count[i] - b);
     }
+  // The credit in one update: the counter is shared by the threads, and an atomic add per pixel
+  // would move its cache line between cores a thousand times a tile.
+  const uint64_t credit = samples - samples_before + stopped_credit;
   m_budget_done.fetch_add(credit, std::memory_order_relaxed);
 }
 

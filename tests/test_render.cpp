@@ -297,6 +297,36 @@ TEST(Adaptive, ConvergedPixelsStopEarlyAndAreNotBiased) {
   EXPECT_GT(rate.mean, 0.6);  // blue-ish: few samples used
 }
 
+// Progress counts a pixel's whole budget once an adaptive stop ends it, and each sample added
+// otherwise: a pass to t of spp samples is t / spp of the way, and an adaptive render that
+// stopped every pixel early is all the way. Batched tiles credit it per tile, scalar ones per row.
+TEST(Adaptive, ProgressCountsStoppedPixelsAsDone) {
+  SceneDesc desc = parse_collada(sphere_scene(0.5f, 0, true), "furnace.dae");
+  for (bool packets : {true, false}) {
+    RenderParams p;
+    p.file_camera = true;
+    p.width = p.height = 8;
+    p.max_depth = 1;
+    p.spp = 256;
+    p.adaptive_batch = 32;
+    p.ray_packets = packets;
+    p.adaptive = false;
+    auto scene = make_render_scene(desc, p);
+    RenderSession fixed(*scene, p);
+    for (int target : {1, 16, 64}) {
+      fixed.render_pass(target);
+      EXPECT_DOUBLE_EQ(fixed.progress(), target / 256.0) << "packets " << packets;
+    }
+    p.adaptive = true;  // every pixel stops at its first check, after 33 samples
+    RenderSession adaptive(*scene, p);
+    adaptive.render_pass(16);
+    EXPECT_DOUBLE_EQ(adaptive.progress(), 16 / 256.0) << "packets " << packets;
+    adaptive.render_pass(64);
+    ASSERT_EQ(adaptive.stats().samples, uint64_t(33 * 64));
+    EXPECT_DOUBLE_EQ(adaptive.progress(), 1.0) << "packets " << packets;
+  }
+}
+
 // Importance sampling of a high-dynamic-range environment (a bright "sun" 60x the dim sky)
 // must be unbiased: it agrees with uniform hemisphere sampling within noise.
 TEST(Estimators, EnvironmentImportanceSamplingIsUnbiased) {
