@@ -99,6 +99,18 @@ def wait_for(predicate, what, timeout=10):
         time.sleep(0.05)
 
 
+def median_pass_rate(workers):
+    """Samples per pixel per second of the workers' passes of 4 or more, median (their logs)."""
+    rates = []
+    for w in workers:
+        for first, end, seconds in re.findall(r"samples \[(\d+), (\d+)\) in ([\d.]+) s", w.text()):
+            n = int(end) - int(first)
+            if n >= 4 and float(seconds) > 0:
+                rates.append(n / float(seconds))
+    rates.sort()
+    return rates[len(rates) // 2] if rates else 0.0
+
+
 def image(api, job_id):
     w, h, ch, attrs = read_exr(api.get(f"/api/jobs/{job_id}/image.exr").content)
     return w, h, ch, attrs
@@ -136,7 +148,15 @@ def test_killed_worker_loses_nothing_and_image_matches_single_process(cluster, s
     m = re.search(rf"job {job_id}: .*spp a pass: ([\d ]+)", srv.log_text())
     assert m, "the server logged no merge summary"
     sizes = [int(n) for n in m.group(1).split()]
-    assert sizes[:2] == [1, 1] and sum(sizes) == JOB["spp"] and max(sizes) >= 16, sizes
+    assert sizes[:2] == [1, 1] and sum(sizes) == JOB["spp"], sizes
+    assert all(n & (n - 1) == 0 for n in sizes), f"pass sizes are powers of two: {sizes}"
+    # Passes aim at about 2 s of a worker's time (kPassSeconds), so how far they grow depends on
+    # the workers' speed: from 8 spp a second a pass outgrows the ramp's 8; at 16 or more (twice
+    # that, for the rate's smoothing) it must. Under a sanitizer on a slow host workers ran 3-7
+    # spp a second and the passes rightly stayed at 8; a plain build there ran about 28.
+    rate = median_pass_rate(workers)
+    if rate >= 16:
+        assert max(sizes) >= 16, (sizes, f"{rate:.1f} spp/s")
 
     # The same job on an embedded server: the same samples, so the same image up to float rounding.
     single = servers("single", threads=2)
