@@ -7,6 +7,19 @@
 
 #include "sampling.h"
 #include "simd.h"
+#include "simd8.h"
+
+// Camera rays in lanes (camera_lanes_body.inc): four wide in SSE2, eight in AVX2.
+namespace pt::lanes_sse2 {
+using namespace pt::simd;
+#include "camera_lanes_body.inc"
+}  // namespace pt::lanes_sse2
+PT_BEGIN_AVX2
+namespace pt::lanes_avx2 {
+using namespace pt::simd8;
+#include "camera_lanes_body.inc"
+}  // namespace pt::lanes_avx2
+PT_END_AVX2
 
 namespace pt {
 
@@ -132,58 +145,16 @@ void Camera::pinhole_ray(float sx, float sy, Ray& r) const {
   r.tmax = tmax;
 }
 
-namespace {
-
-// The camera-space direction through sensor points sx, sy (as pinhole_ray's dc), four lanes.
-__attribute__((always_inline)) inline simd::V3 sensor_direction(const Camera& c, const float* sx, const float* sy) {
-  using namespace simd;
-  const vf one = splat(1.0f), two = splat(2.0f);
-  return {(two * loadu(sx) - one) * splat(c.tan_half_w), (two * loadu(sy) - one) * splat(c.tan_half_h),
-          splat(-1.0f)};
-}
-
-// Camera-space d to world space: right * d.x + up * d.y + back * d.z, as the scalar sum.
-__attribute__((always_inline)) inline simd::V3 to_world(const Camera& c, simd::V3 d) {
-  using namespace simd;
-  return add(add(mul(broadcast(c.right), d.x), mul(broadcast(c.up), d.y)), mul(broadcast(c.back), d.z));
-}
-
-__attribute__((always_inline)) inline void write_rays(const Camera& c, simd::V3 o, simd::V3 d, Ray* out) {
-  for (int k = 0; k < 4; ++k) {
-    out[k].o = Vec3(o.x[k], o.y[k], o.z[k]);
-    out[k].d = Vec3(d.x[k], d.y[k], d.z[k]);
-    out[k].tmin = c.tmin;
-    out[k].tmax = c.tmax;
-  }
-}
-
-}  // namespace
-
 void Camera::pinhole_rays(const float* sx, const float* sy, size_t n, Ray* out) const {
-  using namespace simd;
-  const V3 o = broadcast(position);
-  size_t i = 0;
-  for (; i + 4 <= n; i += 4)  // pinhole_ray, operation for operation
-    write_rays(*this, o, normalize(to_world(*this, sensor_direction(*this, sx + i, sy + i))), out + i);
+  size_t i = simd::use_avx2() ? lanes_avx2::pinhole_rays(*this, sx, sy, n, out) : 0;
+  i += lanes_sse2::pinhole_rays(*this, sx + i, sy + i, n - i, out + i);
   for (; i < n; ++i) pinhole_ray(sx[i], sy[i], out[i]);
 }
 
 void Camera::generate_rays(const float* sx, const float* sy, const Vec2* lens_u, size_t n, Ray* out) const {
   if (lens_radius <= 0) return pinhole_rays(sx, sy, n, out);
-  using namespace simd;
-  const V3 r = broadcast(right), u = broadcast(up), o = broadcast(position);
-  const vf f = splat(focal_distance), radius = splat(lens_radius);
-  size_t i = 0;
-  for (; i + 4 <= n; i += 4) {  // generate_ray, operation for operation
-    const Vec2* l = lens_u + i;
-    vf dx, dy;
-    concentric_disk(vf{l[0].x, l[1].x, l[2].x, l[3].x}, vf{l[0].y, l[1].y, l[2].y, l[3].y}, dx, dy);
-    V3 dc = sensor_direction(*this, sx + i, sy + i);
-    vf lx = radius * dx, ly = radius * dy;
-    V3 dir{dc.x * f - lx, dc.y * f - ly, dc.z * f - vf{}};
-    dir = sel(dot(dir, dir) > 0, dir, dc);
-    write_rays(*this, add(add(o, mul(r, lx)), mul(u, ly)), normalize(to_world(*this, dir)), out + i);
-  }
+  size_t i = simd::use_avx2() ? lanes_avx2::thin_lens_rays(*this, sx, sy, lens_u, n, out) : 0;
+  i += lanes_sse2::thin_lens_rays(*this, sx + i, sy + i, lens_u + i, n - i, out + i);
   for (; i < n; ++i) generate_ray(sx[i], sy[i], lens_u[i], out[i]);
 }
 

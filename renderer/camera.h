@@ -35,10 +35,11 @@ struct Camera {
   // The pinhole ray through the same sensor point (what autofocus casts).
   Ray pinhole_ray(float sx, float sy) const;
   void pinhole_ray(float sx, float sy, Ray& r) const;
-  // pinhole_ray for sensor points (sx[i], sy[i]), i < n, four at a time in SSE2 lanes (the same bits).
+  // pinhole_ray for sensor points (sx[i], sy[i]), i < n, in lanes (the same bits): eight at a
+  // time in AVX2 where simd::use_avx2(), then four in SSE2, the tail one by one.
   void pinhole_rays(const float* sx, const float* sy, size_t n, Ray* out) const;
-  // generate_ray for sensor points (sx[i], sy[i]) and lens samples lens_u[i], i < n, four at a
-  // time in SSE2 lanes (the same bits). Any camera: a pinhole's rays ignore lens_u.
+  // generate_ray for sensor points (sx[i], sy[i]) and lens samples lens_u[i], i < n, in lanes as
+  // pinhole_rays (the same bits). Any camera: a pinhole's rays ignore lens_u.
   void generate_rays(const float* sx, const float* sy, const Vec2* lens_u, size_t n, Ray* out) const;
   // The inverse of generate_ray: the sensor point (sx, sy) whose ray from lens sample lens_u passes
   // through world point p, and that ray's origin. False for a point not in front of the lens or a

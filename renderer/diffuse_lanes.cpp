@@ -6,6 +6,7 @@
 #include "diffuse_lanes.h"
 
 #include "simd.h"
+#include "simd8.h"
 
 // SSE2: four lanes, the portable build.
 namespace pt::lanes::sse2 {
@@ -13,39 +14,19 @@ using namespace pt::simd;
 #include "diffuse_lanes_body.inc"
 }  // namespace pt::lanes::sse2
 
-// AVX2: eight lanes, for the CPUs that have it. Everything in this region is compiled for AVX2 (a
-// target pragma for GCC, an attribute pragma for clang, which the sanitizer build uses) and
-// lives in its own namespaces, so no inline function of a header gets an AVX2 copy that the linker
-// could pick for the portable code. AVX2 without FMA: the same roundings as SSE2.
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
-namespace pt::simd8 {
-#define PT_SIMD_WIDTH 8
-#include "simd_ops.inc"
-#undef PT_SIMD_WIDTH
-}  // namespace pt::simd8
+// AVX2: eight lanes, for the CPUs that have it (simd8.h, PT_BEGIN_AVX2 in simd.h).
+PT_BEGIN_AVX2
 namespace pt::lanes::avx2 {
 using namespace pt::simd8;
 #include "diffuse_lanes_body.inc"
 }  // namespace pt::lanes::avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+PT_END_AVX2
 
 namespace pt::lanes {
 
-namespace {
-bool g_allow_avx2 = true;
-bool use_avx2() { return g_allow_avx2 && simd::avx2_available(); }
-}  // namespace
+using simd::use_avx2;
 
-void allow_avx2(bool allow) { g_allow_avx2 = allow; }
+void allow_avx2(bool allow) { simd::allow_avx2(allow); }
 int lane_width() { return use_avx2() ? 8 : 4; }
 
 void light_pass(DiffuseVertices& v, int n, const Light& light, int samples) {

@@ -146,7 +146,7 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   static thread_local std::vector<Job> jobs;
   static thread_local std::vector<Sampler> rngs;
   // Camera rays are made at the flush: each job's pixel corner, then its sensor and lens draws for
-  // all jobs at once, then the rays four at a time (generate_rays).
+  // all jobs at once, then the rays in lanes (generate_rays).
   static thread_local std::vector<float> sensor_x, sensor_y;
   static thread_local std::vector<uint32_t> job_base, job_sample;
   static thread_local std::vector<Vec2> draws;

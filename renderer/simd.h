@@ -1,6 +1,6 @@
 // Four floats at a time with GCC vector extensions on SSE2 (the portable build's vectors), for
-// the loops that repeat scalar code lane by lane (diffuse_lanes.cpp, Camera::pinhole_rays). The
-// helpers are in simd_ops.inc, which diffuse_lanes.cpp also instantiates eight wide for AVX2.
+// the loops that repeat scalar code lane by lane (diffuse_lanes.cpp, camera.cpp). The helpers
+// are in simd_ops.inc, which simd8.h also instantiates eight wide for AVX2.
 #pragma once
 
 #include <immintrin.h>
@@ -21,4 +21,22 @@ inline bool avx2_available() {
   return avx2;
 }
 
+// The AVX2 code paths (diffuse lanes, camera rays) run where the CPU has AVX2 and this allows them:
+// tests turn them off to check the SSE2 paths on AVX2 machines.
+inline bool g_allow_avx2 = true;
+inline void allow_avx2(bool allow) { g_allow_avx2 = allow; }
+inline bool use_avx2() { return g_allow_avx2 && avx2_available(); }
+
 }  // namespace pt::simd
+
+// Code between these is compiled for AVX2: a target pragma for GCC, an attribute pragma for clang
+// (which the sanitizer build uses). Keep such code in namespaces of its own (see simd8.h), so
+// that no inline function of a header gets an AVX2 copy that the linker could pick for the
+// portable code. AVX2 without FMA: the same roundings as SSE2.
+#if defined(__clang__)
+#define PT_BEGIN_AVX2 _Pragma("clang attribute push(__attribute__((target(\"avx2\"))), apply_to = function)")
+#define PT_END_AVX2 _Pragma("clang attribute pop")
+#else
+#define PT_BEGIN_AVX2 _Pragma("GCC push_options") _Pragma("GCC target(\"avx2\")")
+#define PT_END_AVX2 _Pragma("GCC pop_options")
+#endif

@@ -7,6 +7,7 @@
 
 #include "collada.h"
 #include "rng.h"
+#include "simd.h"
 #include "test_util.h"
 
 using namespace pt;
@@ -231,61 +232,76 @@ Camera tilted_camera(Vec3 back) {
   return c;
 }
 
-// Camera rays four at a time (render_tile's pinhole batches) must be pinhole_ray's bits, for any
-// count (the tail of fewer than four goes one by one) and sensor points on and off the sensor.
+struct AllowAvx2Afterwards {  // a failed ASSERT must not leave the AVX2 paths off for later tests
+  ~AllowAvx2Afterwards() { simd::allow_avx2(true); }
+};
+
+// Camera rays eight at a time in AVX2 and four in SSE2 (render_tile's batches) must be
+// pinhole_ray's bits, for any count (eight-wide groups, then four-wide, then the tail one by one)
+// and sensor points on and off the sensor. Without AVX2 both rounds check the SSE2 lanes.
 TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
   Camera c = tilted_camera(Vec3(0.3f, -0.5f, 0.8f));
   Pcg32 rng(7, 11);
-  for (size_t n : {size_t(0), size_t(1), size_t(4), size_t(7), size_t(1001)}) {
-    std::vector<float> sx(n), sy(n);
-    for (size_t i = 0; i < n; ++i) {
-      sx[i] = 1.4f * rng.next_float() - 0.2f;
-      sy[i] = 1.4f * rng.next_float() - 0.2f;
-    }
-    if (n > 2) sx[1] = sy[1] = 0.5f, sx[2] = 0, sy[2] = 1;  // the centre and a corner exactly
-    std::vector<Ray> lanes(n);
-    c.pinhole_rays(sx.data(), sy.data(), n, lanes.data());
-    for (size_t i = 0; i < n; ++i) {
-      Ray one = c.pinhole_ray(sx[i], sy[i]);
-      SCOPED_TRACE(i);
-      EXPECT_EQ(lanes[i].o, one.o);
-      EXPECT_EQ(lanes[i].d, one.d);
-      EXPECT_EQ(lanes[i].tmin, one.tmin);
-      EXPECT_EQ(lanes[i].tmax, one.tmax);
+  AllowAvx2Afterwards restore;
+  for (bool avx2 : {true, false}) {
+    simd::allow_avx2(avx2);
+    for (size_t n : {size_t(0), size_t(1), size_t(4), size_t(7), size_t(13), size_t(1001)}) {
+      SCOPED_TRACE(testing::Message() << (avx2 ? "AVX2 where the CPU has it" : "SSE2") << ", " << n << " rays");
+      std::vector<float> sx(n), sy(n);
+      for (size_t i = 0; i < n; ++i) {
+        sx[i] = 1.4f * rng.next_float() - 0.2f;
+        sy[i] = 1.4f * rng.next_float() - 0.2f;
+      }
+      if (n > 2) sx[1] = sy[1] = 0.5f, sx[2] = 0, sy[2] = 1;  // the centre and a corner exactly
+      std::vector<Ray> lanes(n);
+      c.pinhole_rays(sx.data(), sy.data(), n, lanes.data());
+      for (size_t i = 0; i < n; ++i) {
+        Ray one = c.pinhole_ray(sx[i], sy[i]);
+        SCOPED_TRACE(i);
+        EXPECT_EQ(lanes[i].o, one.o);
+        EXPECT_EQ(lanes[i].d, one.d);
+        EXPECT_EQ(lanes[i].tmin, one.tmin);
+        EXPECT_EQ(lanes[i].tmax, one.tmax);
+      }
     }
   }
 }
 
-// generate_rays in lanes against generate_ray: a thin lens (and one focused at 0, where the lens
-// centre's ray falls back to the pinhole direction), lens samples at the disk map's centre and
-// edges, and a pinhole (which ignores the lens samples).
+// generate_rays in lanes (both widths, as above) against generate_ray: a thin lens (and one
+// focused at 0, where the lens centre's ray falls back to the pinhole direction), lens samples at
+// the disk map's centre and edges, and a pinhole (which ignores the lens samples).
 TEST(Camera, ThinLensRaysInLanesAreGenerateRaysBits) {
   Camera c = tilted_camera(Vec3(-0.6f, 0.2f, 0.7f));
   Pcg32 rng(3, 5);
-  for (auto [radius, focus] : {std::pair{0.2f, 3.5f}, std::pair{0.3f, 0.0f}, std::pair{0.0f, 4.7f}}) {
-    c.lens_radius = radius, c.focal_distance = focus;
-    for (size_t n : {size_t(0), size_t(3), size_t(8), size_t(1001)}) {
-      std::vector<float> sx(n), sy(n);
-      std::vector<Vec2> lens(n);
-      for (size_t i = 0; i < n; ++i) {
-        sx[i] = 1.4f * rng.next_float() - 0.2f;
-        sy[i] = 1.4f * rng.next_float() - 0.2f;
-        lens[i] = rng.next_2d();
-      }
-      if (n > 7) {
-        lens[1] = {0.5f, 0.5f};  // the lens centre
-        lens[2] = {0, 0.5f}, lens[3] = {0.5f, 0.9999999f}, lens[4] = {0, 0};  // edges and a corner
-        lens[5] = {0.75f, 0.75f}, sx[5] = sy[5] = 0.5f;  // a diagonal, through the sensor centre
-      }
-      std::vector<Ray> lanes(n);
-      c.generate_rays(sx.data(), sy.data(), lens.data(), n, lanes.data());
-      for (size_t i = 0; i < n; ++i) {
-        Ray one = c.generate_ray(sx[i], sy[i], lens[i]);
-        SCOPED_TRACE(testing::Message() << "radius " << radius << " focus " << focus << " ray " << i);
-        ASSERT_EQ(std::memcmp(&lanes[i].o, &one.o, sizeof one.o), 0);
-        ASSERT_EQ(std::memcmp(&lanes[i].d, &one.d, sizeof one.d), 0);
-        ASSERT_EQ(lanes[i].tmin, one.tmin);
-        ASSERT_EQ(lanes[i].tmax, one.tmax);
+  AllowAvx2Afterwards restore;
+  for (bool avx2 : {true, false}) {
+    simd::allow_avx2(avx2);
+    for (auto [radius, focus] : {std::pair{0.2f, 3.5f}, std::pair{0.3f, 0.0f}, std::pair{0.0f, 4.7f}}) {
+      c.lens_radius = radius, c.focal_distance = focus;
+      for (size_t n : {size_t(0), size_t(3), size_t(8), size_t(13), size_t(1001)}) {
+        std::vector<float> sx(n), sy(n);
+        std::vector<Vec2> lens(n);
+        for (size_t i = 0; i < n; ++i) {
+          sx[i] = 1.4f * rng.next_float() - 0.2f;
+          sy[i] = 1.4f * rng.next_float() - 0.2f;
+          lens[i] = rng.next_2d();
+        }
+        if (n > 7) {
+          lens[1] = {0.5f, 0.5f};  // the lens centre
+          lens[2] = {0, 0.5f}, lens[3] = {0.5f, 0.9999999f}, lens[4] = {0, 0};  // edges and a corner
+          lens[5] = {0.75f, 0.75f}, sx[5] = sy[5] = 0.5f;  // a diagonal, through the sensor centre
+        }
+        std::vector<Ray> lanes(n);
+        c.generate_rays(sx.data(), sy.data(), lens.data(), n, lanes.data());
+        for (size_t i = 0; i < n; ++i) {
+          Ray one = c.generate_ray(sx[i], sy[i], lens[i]);
+          SCOPED_TRACE(testing::Message() << (avx2 ? "AVX2 where the CPU has it" : "SSE2") << ", radius " << radius
+                                          << " focus " << focus << " ray " << i);
+          ASSERT_EQ(std::memcmp(&lanes[i].o, &one.o, sizeof one.o), 0);
+          ASSERT_EQ(std::memcmp(&lanes[i].d, &one.d, sizeof one.d), 0);
+          ASSERT_EQ(lanes[i].tmin, one.tmin);
+          ASSERT_EQ(lanes[i].tmax, one.tmax);
+        }
       }
     }
   }
