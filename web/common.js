@@ -81,7 +81,8 @@ function askToken() {
   return tokenPrompt;
 }
 
-// fetch + JSON. Resolves {ok, status, data}; resolves null when the server cannot be reached.
+// fetch + JSON. Resolves {ok, status, data}; resolves null when the server cannot be reached or
+// its JSON answer is cut short.
 async function api(path, options = {}, retried = false) {
   let res;
   try {
@@ -94,7 +95,12 @@ async function api(path, options = {}, retried = false) {
   let data = null;
   const type = res.headers.get('Content-Type') || '';
   if (type.includes('application/json')) {
-    try { data = await res.json(); } catch (e) { data = null; }
+    try {
+      data = await res.json();
+    } catch (e) {
+      connectionLost();  // a JSON answer cut short: the server went away mid-answer
+      return null;
+    }
   }
   return { ok: res.ok, status: res.status, data };
 }

@@ -326,6 +326,23 @@ test('a narrow window needs no sideways scrolling', async () => {
   await page.setViewportSize({ width: 1280, height: 900 });
 });
 
+// A server that goes away mid-answer leaves a JSON body cut short: the page shows a lost
+// connection and polls again, instead of failing on the missing data (seen once in CI).
+test('a JSON answer cut short counts as a lost connection, not an error', async () => {
+  const errors = pageErrors.length;
+  let cut = 0;
+  await page.route('**/api/jobs', (route) => {
+    if (cut++ === 0) return route.fulfill({ status: 200, contentType: 'application/json', body: '{"jobs": [{"id": ' });
+    return route.continue();
+  });
+  await page.evaluate(() => refreshJobs());
+  await page.waitForSelector('#conn[data-state="reconnecting"]');
+  await page.waitForSelector('#conn[data-state="live"]');
+  await page.unroute('**/api/jobs');
+  assert.ok(cut >= 2, 'the page polled again after the cut answer');
+  assert.deepEqual(pageErrors.slice(errors), []);
+});
+
 test('no uncaught errors on the page', () => {
   assert.deepEqual(pageErrors, []);
 });
