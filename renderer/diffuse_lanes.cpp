@@ -26,7 +26,6 @@ namespace pt::lanes {
 
 using simd::use_avx2;
 
-void allow_avx2(bool allow) { simd::allow_avx2(allow); }
 int lane_width() { return use_avx2() ? 8 : 4; }
 
 void light_pass(DiffuseVertices& v, int n, const Light& light, int samples) {

@@ -50,9 +50,7 @@ void light_pass(DiffuseVertices& v, int n, const Light& light, int samples);
 // The cosine-weighted bounce, throughput update and Russian roulette for vertices [0, n).
 void bounce_pass(DiffuseVertices& v, int n);
 
-// The lanes' width: 8 where the CPU has AVX2 (and it is allowed), else 4. allow_avx2(false) keeps
-// them on SSE2, for tests and comparisons; it is not for use while a render runs.
+// The lanes' width: 8 where the CPU has AVX2 (and simd::allow_avx2 allows it), else 4.
 int lane_width();
-void allow_avx2(bool allow);
 
 }  // namespace pt::lanes

@@ -445,6 +445,8 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
     scene.accel->occluded_many(shadow_rays.data(), shadow_rays.size(), blocked.data());
     for (size_t k = 0; k < shadows.size(); ++k)  // in order: each vertex sums its lights as the scalar loop does
       if (!blocked[k]) slots[shadows[k].slot].st.direct_sum += shadows[k].contribution;
+    // A finished path's slot takes the next camera ray in place; once there are none, the last
+    // slot moves into it (a copy of the whole state: only while the pool drains).
     for (size_t i = 0; i < live;) {
       slots[i].st.resolve_direct();
       if (alive[i]) {
@@ -452,6 +454,12 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
         continue;
       }
       out[slots[i].job] = slots[i].st.radiance;
+      if (next < n) {
+        slots[i].st.start(camera_rays[next], params.max_depth);
+        slots[i].job = uint32_t(next++);
+        ++i;
+        continue;
+      }
       --live;
       slots[i] = slots[live];
       alive[i] = alive[live];

@@ -9,6 +9,7 @@
 #include "collada.h"
 #include "diffuse_lanes.h"
 #include "render.h"
+#include "simd.h"
 #include "test_util.h"
 
 using namespace pt;
@@ -111,8 +112,11 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
     EXPECT_FALSE(diffuse_lanes_apply(*scene, one));
     RenderSession without(*scene, one);
     without.render_all();
+    struct AllowAvx2Afterwards {  // also when an assertion leaves the loop
+      ~AllowAvx2Afterwards() { simd::allow_avx2(true); }
+    } restore;
     for (bool avx2 : {true, false}) {  // eight lanes where the CPU has AVX2, and four (SSE2)
-      lanes::allow_avx2(avx2);
+      simd::allow_avx2(avx2);
       SCOPED_TRACE(testing::Message() << lanes::lane_width() << " lanes");
       RenderSession with(*scene, p);
       with.render_all();
@@ -123,7 +127,6 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
       EXPECT_EQ(with.pixel_counts(), without.pixel_counts());
       EXPECT_EQ(with.stats().nonfinite, 0u);
     }
-    lanes::allow_avx2(true);
   }
   EXPECT_GE(laned, 6) << "the own scenes' lights take the lanes: rectangles (1 or 3 samples), a mesh";
 }
