@@ -162,8 +162,8 @@ struct SamplerLanes {
     size_t m = 0;
     for (size_t i = 0; i < n; ++i) {
       Sampler& r = s(i);
-      if (r.m_dim >= Sampler::kSobolDimensions) {
-        out[i] = r.next_2d();
+      if (r.m_dim >= Sampler::kSobolDimensions) {  // next_2d's own branch, inlined: deep paths draw here
+        out[i] = r.rng().next_2d();
         continue;
       }
       t.base[m] = r.m_base, t.index[m] = r.m_index_reversed, t.dim[m] = ++r.m_dim, t.which[m] = uint32_t(i);
