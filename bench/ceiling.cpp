@@ -8,6 +8,7 @@
 // the replay's is the share of its time the ray queries would take if nothing else cost anything.
 //
 //   bench_ceiling [--spp 16] [--runs 5] [--scene NAME] [--sampler sobol|independent] [--smoke]
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -159,24 +160,26 @@ int main(int argc, char** argv) {
       const std::vector<double>& own = p.ray_packets ? acc16 : acc;
       std::vector<double> paired;
       for (size_t r = 0; r < pt_rate.size(); ++r) paired.push_back(pt_rate[r] / own[r]);
+      // The spread of the paired ratios: on a noisy host the median alone hides how close it is.
+      const auto [lo, hi] = std::minmax_element(paired.begin(), paired.end());
       char line[512];
       std::snprintf(line, sizeof line,
-                    "%-10s %7d %8.2f M %7.1f%% %9.2f %9.2f M %10.2f M %10.2f M %10.2f %9.2f M %11.2f M %11.2f M",
+                    "%-10s %7d %8.2f M %7.1f%% %9.2f %9.2f M %10.2f M %10.2f M %10.2f %4.2f-%4.2f %9.2f M %11.2f M %11.2f M",
                     sc.name.c_str(), threads, rec.rays.size() / 1e6, 100.0 * shadows / std::max<size_t>(1, rec.rays.size()),
                     double(pt_rays) / std::max<uint64_t>(1, pt_samples), median(pt_rate) / 1e6, median(acc) / 1e6,
-                    median(acc16) / 1e6, median(paired), median(raw) / 1e6, median(stream) / 1e6,
+                    median(acc16) / 1e6, median(paired), *lo, *hi, median(raw) / 1e6, median(stream) / 1e6,
                     median(packet) / 1e6);
       table.push_back(line);
     }
   }
   bar.finish();
-  std::printf("%-10s %7s %10s %8s %9s %11s %12s %12s %10s %11s %13s %13s\n", "scene", "threads", "rays", "shadow",
-              "rays/spl", "PT rays/s", "replay 1", "replay 16", "PT/replay", "raw 1 rays/s", "stream rays/s",
+  std::printf("%-10s %7s %10s %8s %9s %11s %12s %12s %10s %9s %11s %13s %13s\n", "scene", "threads", "rays", "shadow",
+              "rays/spl", "PT rays/s", "replay 1", "replay 16", "PT/replay", "min-max", "raw 1 rays/s", "stream rays/s",
               "packet rays/s");
   for (const std::string& l : table) std::printf("%s\n", l.c_str());
   std::printf("PT = the path tracer's rays/s on the same pass (rays that reach Accel), %s; replay 1 = Accel::intersect / "
               "occluded; replay 16 = Accel::intersect_many / occluded_many (packets of 16); PT/replay = median over runs of PT over the "
-              "replay that traces as the path tracer does, in the same run; raw 1 = rtcIntersect1 / rtcOccluded1; stream = "
+              "replay that traces as the path tracer does, in the same run (min-max: the smallest and largest of those runs); raw 1 = rtcIntersect1 / rtcOccluded1; stream = "
               "rtcIntersect1M / rtcOccluded1M, %zu rays a call; packet = rtcIntersect16 / rtcOccluded16\n",
               RenderParams().ray_packets ? "in packets of 16" : "one ray at a time", batch);
   return 0;

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <regex>
 #include <string>
 
 #include "test_util.h"
@@ -39,7 +40,21 @@ TEST(BenchSmoke, Convergence) {
   EXPECT_TRUE(pt::test::file_exists(dir + "/convergence_dof_m5_sobol.png"));
 }
 
-TEST(BenchSmoke, Ceiling) { expect_runs("bench_ceiling", "", "replay 1    replay 16  PT/replay"); }
+TEST(BenchSmoke, Ceiling) {
+  std::string out;
+  ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_ceiling --smoke --runs 3", out), 0) << out;
+  EXPECT_NE(out.find("replay 1    replay 16  PT/replay   min-max"), std::string::npos) << out;
+  // Each row's median paired ratio lies within its min-max.
+  std::regex ratio(R"( (\d+\.\d\d) (\d+\.\d\d)-(\d+\.\d\d) )");
+  int rows = 0;
+  for (std::sregex_iterator m(out.begin(), out.end(), ratio), end; m != end; ++m, ++rows) {
+    double median = std::stod((*m)[1]), lo = std::stod((*m)[2]), hi = std::stod((*m)[3]);
+    EXPECT_LE(lo, median) << m->str();
+    EXPECT_LE(median, hi) << m->str();
+    EXPECT_GT(lo, 0) << m->str();
+  }
+  EXPECT_EQ(rows, 2) << "one row per thread count:\n" << out;
+}
 
 TEST(BenchSmoke, Scaling) { expect_runs("bench_scaling", "", "samples/s 1t samples/s 2t   2t/1t"); }
 
