@@ -232,17 +232,13 @@ Camera tilted_camera(Vec3 back) {
   return c;
 }
 
-struct AllowAvx2Afterwards {  // a failed ASSERT must not leave the AVX2 paths off for later tests
-  ~AllowAvx2Afterwards() { simd::allow_avx2(true); }
-};
-
 // Camera rays eight at a time in AVX2 and four in SSE2 (render_tile's batches) must be
 // pinhole_ray's bits, for any count (eight-wide groups, then four-wide, then the tail one by one)
 // and sensor points on and off the sensor. Without AVX2 both rounds check the SSE2 lanes.
 TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
   Camera c = tilted_camera(Vec3(0.3f, -0.5f, 0.8f));
   Pcg32 rng(7, 11);
-  AllowAvx2Afterwards restore;
+  test::AllowAvx2Afterwards restore;
   for (bool avx2 : {true, false}) {
     simd::allow_avx2(avx2);
     for (size_t n : {size_t(0), size_t(1), size_t(4), size_t(7), size_t(13), size_t(1001)}) {
@@ -273,7 +269,7 @@ TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
 TEST(Camera, ThinLensRaysInLanesAreGenerateRaysBits) {
   Camera c = tilted_camera(Vec3(-0.6f, 0.2f, 0.7f));
   Pcg32 rng(3, 5);
-  AllowAvx2Afterwards restore;
+  test::AllowAvx2Afterwards restore;
   for (bool avx2 : {true, false}) {
     simd::allow_avx2(avx2);
     for (auto [radius, focus] : {std::pair{0.2f, 3.5f}, std::pair{0.3f, 0.0f}, std::pair{0.0f, 4.7f}}) {

@@ -9,7 +9,6 @@
 #include "collada.h"
 #include "diffuse_lanes.h"
 #include "render.h"
-#include "simd.h"
 #include "test_util.h"
 
 using namespace pt;
@@ -112,9 +111,7 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
     EXPECT_FALSE(diffuse_lanes_apply(*scene, one));
     RenderSession without(*scene, one);
     without.render_all();
-    struct AllowAvx2Afterwards {  // also when an assertion leaves the loop
-      ~AllowAvx2Afterwards() { simd::allow_avx2(true); }
-    } restore;
+    test::AllowAvx2Afterwards restore;
     for (bool avx2 : {true, false}) {  // eight lanes where the CPU has AVX2, and four (SSE2)
       simd::allow_avx2(avx2);
       SCOPED_TRACE(testing::Message() << lanes::lane_width() << " lanes");

@@ -10,8 +10,15 @@
 
 #include "collada.h"
 #include "image.h"
+#include "simd.h"
 
 namespace pt::test {
+
+// Tests that run the SSE2 paths on an AVX2 machine (simd::allow_avx2(false)) hold one of these: a
+// failed ASSERT must not leave the AVX2 paths off for the tests after it.
+struct AllowAvx2Afterwards {
+  ~AllowAvx2Afterwards() { simd::allow_avx2(true); }
+};
 
 inline bool file_exists(const std::string& p) {
   struct stat st;
