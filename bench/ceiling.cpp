@@ -1,10 +1,11 @@
 // bench_ceiling: how fast Embree alone traces the rays our path tracer casts. Records every ray
 // of one 16-spp pass (record_rays_on_this_thread, renderer/accel.h), then replays the list in a
-// tight loop with 1 and 2 threads (the list split in halves) five ways: through Accel::intersect
+// tight loop with 1 and 2 threads (the list split in halves) six ways: through Accel::intersect
 // / occluded (our wrapper, hit refinement included), through Accel::intersect_many / occluded_many
-// (the same in packets of 16, what the path tracer calls), raw rtcIntersect1 / rtcOccluded1,
-// Embree's stream API (rtcIntersect1M / rtcOccluded1M), and raw packets of 16 (rtcIntersect16 /
-// rtcOccluded16, as Mitsuba 3's LLVM variants trace on AVX-512). The path tracer's own rays/s on the same pass over
+// (the same in Embree packets of the CPU's native width, what the path tracer calls), raw
+// rtcIntersect1 / rtcOccluded1, Embree's stream API (rtcIntersect1M / rtcOccluded1M), and raw
+// packets of 16 (rtcIntersect16 / rtcOccluded16, as Mitsuba 3's LLVM variants trace on AVX-512)
+// and of 8 (rtcIntersect8 / rtcOccluded8). The path tracer's own rays/s on the same pass over
 // the replay's is the share of its time the ray queries would take if nothing else cost anything.
 //
 //   bench_ceiling [--spp 16] [--runs 5] [--scene NAME] [--sampler sobol|independent] [--smoke]
@@ -28,7 +29,7 @@ namespace {
 
 const char* kUsage = "bench_ceiling [--spp N=16] [--runs N=5] [--batch N=256] [--scene NAME] [--sampler sobol|independent] [--smoke]";
 
-enum class Mode { accel, accel16, raw, stream, packet16 };
+enum class Mode { accel, accel_many, raw, stream, packet16, packet8 };
 
 size_t replay(const Accel& a, const RayRecorder& rec, size_t begin, size_t end, Mode mode, size_t batch) {
   const Ray* rays = rec.rays.data();
@@ -37,8 +38,9 @@ size_t replay(const Accel& a, const RayRecorder& rec, size_t begin, size_t end, 
   if (mode == Mode::stream) return a.cast_raw(rays + begin, shadow + begin, end - begin, Accel::RawMode::stream, batch);
   if (mode == Mode::packet16)
     return a.cast_raw(rays + begin, shadow + begin, end - begin, Accel::RawMode::packet16, 16);
+  if (mode == Mode::packet8) return a.cast_raw(rays + begin, shadow + begin, end - begin, Accel::RawMode::packet8, 8);
   size_t hits = 0;
-  if (mode == Mode::accel16) {  // runs of up to 256 rays of a kind, as the path tracer's pool casts them
+  if (mode == Mode::accel_many) {  // runs of up to 256 rays of a kind, as the path tracer's pool casts them
     constexpr size_t kRun = 256;
     std::vector<SurfaceHit> found_hits(kRun);
     std::vector<uint8_t> found(kRun);
@@ -95,9 +97,10 @@ int main(int argc, char** argv) {
               "%s sampler, replayed; rays/s are medians of %d runs\n",
               spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);
   std::vector<std::string> table;
+  int packet_width = 0;  // Accel's, the same for every scene (Embree's native width)
   ProgressBar bar("bench_ceiling");
   int done = 0;
-  const int total = int(scenes.size()) * 2 * 6 * runs;
+  const int total = int(scenes.size()) * 2 * 7 * runs;
   for (BenchScene sc : scenes) {
     sc.max_depth = 5;
     SceneDesc desc = load_collada(sc.path);
@@ -132,10 +135,11 @@ int main(int argc, char** argv) {
     for (uint8_t s : rec.shadow) shadows += s;
 
     const Accel& accel = *scene->accel;
-    for (Mode m : {Mode::accel, Mode::accel16, Mode::raw, Mode::stream, Mode::packet16})
+    packet_width = accel.packet_width();
+    for (Mode m : {Mode::accel, Mode::accel_many, Mode::raw, Mode::stream, Mode::packet16, Mode::packet8})
       replay_rate(accel, rec, 1, m, batch);  // warm up
     for (int threads : {1, 2}) {
-      std::vector<double> pt_rate, acc, acc16, raw, stream, packet;
+      std::vector<double> pt_rate, acc, acc_many, raw, stream, packet, packet8;
       for (int r = 0; r < runs; ++r) {  // interleaved, so drift hits every column alike
         RenderParams pt = p;
         pt.threads = threads;
@@ -143,7 +147,7 @@ int main(int argc, char** argv) {
         s.render_pass(spp);
         pt_rate.push_back(double(rec.rays.size()) / s.stats().seconds);
         bar.update(double(++done) / total);
-        acc16.push_back(replay_rate(accel, rec, threads, Mode::accel16, batch));
+        acc_many.push_back(replay_rate(accel, rec, threads, Mode::accel_many, batch));
         bar.update(double(++done) / total);
         acc.push_back(replay_rate(accel, rec, threads, Mode::accel, batch));
         bar.update(double(++done) / total);
@@ -153,34 +157,37 @@ int main(int argc, char** argv) {
         bar.update(double(++done) / total);
         packet.push_back(replay_rate(accel, rec, threads, Mode::packet16, batch));
         bar.update(double(++done) / total);
+        packet8.push_back(replay_rate(accel, rec, threads, Mode::packet8, batch));
+        bar.update(double(++done) / total);
       }
       // The path tracer casts packets unless told not to; its ceiling is the replay the same way.
       // Each run's PT over the replay right after it, then the median: pairs cancel the machine's
       // slow drift, which a ratio of two medians taken over the whole run does not.
-      const std::vector<double>& own = p.ray_packets ? acc16 : acc;
+      const std::vector<double>& own = p.ray_packets ? acc_many : acc;
       std::vector<double> paired;
       for (size_t r = 0; r < pt_rate.size(); ++r) paired.push_back(pt_rate[r] / own[r]);
       // The spread of the paired ratios: on a noisy host the median alone hides how close it is.
       const auto [lo, hi] = std::minmax_element(paired.begin(), paired.end());
       char line[512];
       std::snprintf(line, sizeof line,
-                    "%-10s %7d %8.2f M %7.1f%% %9.2f %9.2f M %10.2f M %10.2f M %10.2f %4.2f-%4.2f %9.2f M %11.2f M %11.2f M",
+                    "%-10s %7d %8.2f M %7.1f%% %9.2f %9.2f M %10.2f M %10.2f M %10.2f %4.2f-%4.2f %9.2f M %11.2f M %11.2f M %11.2f M",
                     sc.name.c_str(), threads, rec.rays.size() / 1e6, 100.0 * shadows / std::max<size_t>(1, rec.rays.size()),
                     double(pt_rays) / std::max<uint64_t>(1, pt_samples), median(pt_rate) / 1e6, median(acc) / 1e6,
-                    median(acc16) / 1e6, median(paired), *lo, *hi, median(raw) / 1e6, median(stream) / 1e6,
-                    median(packet) / 1e6);
+                    median(acc_many) / 1e6, median(paired), *lo, *hi, median(raw) / 1e6, median(stream) / 1e6,
+                    median(packet) / 1e6, median(packet8) / 1e6);
       table.push_back(line);
     }
   }
   bar.finish();
-  std::printf("%-10s %7s %10s %8s %9s %11s %12s %12s %10s %9s %11s %13s %13s\n", "scene", "threads", "rays", "shadow",
-              "rays/spl", "PT rays/s", "replay 1", "replay 16", "PT/replay", "min-max", "raw 1 rays/s", "stream rays/s",
-              "packet rays/s");
+  std::printf("%-10s %7s %10s %8s %9s %11s %12s %12s %10s %9s %11s %13s %13s %14s\n", "scene", "threads", "rays", "shadow",
+              "rays/spl", "PT rays/s", "replay 1", "replay many", "PT/replay", "min-max", "raw 1 rays/s",
+              "stream rays/s", "packet16 rays/s", "packet8 rays/s");
   for (const std::string& l : table) std::printf("%s\n", l.c_str());
   std::printf("PT = the path tracer's rays/s on the same pass (rays that reach Accel), %s; replay 1 = Accel::intersect / "
-              "occluded; replay 16 = Accel::intersect_many / occluded_many (packets of 16); PT/replay = median over runs of PT over the "
+              "occluded; replay many = Accel::intersect_many / occluded_many (packets of %d); PT/replay = median over runs of PT over the "
               "replay that traces as the path tracer does, in the same run (min-max: the smallest and largest of those runs); raw 1 = rtcIntersect1 / rtcOccluded1; stream = "
-              "rtcIntersect1M / rtcOccluded1M, %zu rays a call; packet = rtcIntersect16 / rtcOccluded16\n",
-              RenderParams().ray_packets ? "in packets of 16" : "one ray at a time", batch);
+              "rtcIntersect1M / rtcOccluded1M, %zu rays a call; packet16 / packet8 = rtcIntersect16 / rtcOccluded16 and "
+              "rtcIntersect8 / rtcOccluded8\n",
+              RenderParams().ray_packets ? "in Embree packets" : "one ray at a time", packet_width, batch);
   return 0;
 }

@@ -43,13 +43,17 @@ class Accel {
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
   // True when anything blocks the ray within [ray.tmin, ray.tmax].
   bool occluded(const Ray& ray) const;
-  // The same queries for n rays at once, traced in Embree packets of 16 (bench_ceiling: 26-38%
-  // more rays/s than one at a time on the course scenes). found[i] / blocked[i] are 1 or 0; hits[i]
+  // The same queries for n rays at once, traced in Embree packets of packet_width() rays
+  // (bench_ceiling: 26-38% more rays/s than one at a time on the course scenes). found[i] / blocked[i] are 1 or 0; hits[i]
   // is written where found[i]. Packet traversal may round a few hits differently from the
   // single-ray kernel (5 in 100,000 random rays in the last bit of t, u, v or Ng; none of them
   // turned a hit into a miss).
   void intersect_many(const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found) const;
   void occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const;
+  // Rays per Embree packet in intersect_many / occluded_many: Embree's native width, 16 on
+  // AVX-512 and 8 below it. set_packet_width (8 or 16) overrides it, for tests and benchmarks.
+  int packet_width() const;
+  void set_packet_width(int width);
   // Bytes held for rendering: everything Embree allocated (BVH, vertex and index buffers, as its
   // memory monitor reports) plus our per-triangle shading data.
   size_t memory_bytes() const;
@@ -60,10 +64,11 @@ class Accel {
   // Benchmarks only (bench/ceiling.cpp; the renderer never calls it): casts rays[0, n) straight
   // through Embree. single: rtcIntersect1 / rtcOccluded1 per ray; stream: rtcIntersect1M /
   // rtcOccluded1M, `batch` rays a call; packet16: rtcIntersect16 / rtcOccluded16, 16 consecutive
-  // rays of a kind a call (what Mitsuba 3's LLVM variants call on AVX-512). Stream and packets
+  // rays of a kind a call (what Mitsuba 3's LLVM variants call on AVX-512); packet8: the same with
+  // rtcIntersect8 / rtcOccluded8 (the native width on AVX2). Stream and packets
   // gather intersect and shadow rays separately. shadow[i] != 0 makes ray i an occlusion query.
   // Returns how many rays hit.
-  enum class RawMode { single, stream, packet16 };
+  enum class RawMode { single, stream, packet16, packet8 };
   size_t cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode mode, size_t batch) const;
 
   struct Impl;

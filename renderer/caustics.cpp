@@ -249,7 +249,7 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
 
 void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
                          uint64_t first, uint64_t count, std::vector<CausticSplat>& out, uint64_t& rays) {
-  // A pool of paths advances a vertex at a time, their rays traced together (Embree packets of 16
+  // A pool of paths advances a vertex at a time, their rays traced together (Embree packets
   // unless --no-ray-packets), then their camera connections. Splats are kept in path order, as
   // one path after another would make them, so the image does not depend on the pool.
   constexpr size_t kSlots = 256;

@@ -143,7 +143,7 @@ std::string usage_text(const std::string& program) {
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
 "  --generic       run the path loop with every feature (for comparisons with the specialised one)\n"
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
-"  --no-ray-packets      trace camera paths one at a time instead of many in Embree packets of 16\n"
+"  --no-ray-packets      trace camera paths one at a time instead of many in Embree packets\n"
 "  --no-simd-lanes       shade packets' diffuse vertices one at a time instead of four in SSE2 lanes,\n"
 "                        and draw their samples one at a time instead of eight in AVX2 lanes\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"

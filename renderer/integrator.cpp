@@ -376,7 +376,7 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
   }
 }
 
-// Many paths at once (Embree packets of 16): a pool of paths advances one vertex at a time, all
+// Many paths at once (Embree packets, Accel::intersect_many): a pool of paths advances one vertex at a time, all
 // their rays traced together, then all their shadow rays; a finished path's slot takes the next
 // one. The same paths as the scalar loop, up to the packet kernel's rounding of a few hits.
 template <uint32_t F>

@@ -42,7 +42,7 @@ struct RenderParams {
   uint64_t seed = 0;               // --seed
   int tile_size = 32;
   bool generic = false;            // --generic: the path loop with every feature (for comparisons)
-  bool ray_packets = true;         // --no-ray-packets: trace paths one at a time, not in packets of 16
+  bool ray_packets = true;         // --no-ray-packets: trace paths one at a time, not in Embree packets
   bool simd_lanes = true;          // --no-simd-lanes: packets' diffuse vertices and sample draws one at a time
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
   bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
@@ -129,7 +129,7 @@ using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class 
 PathTracer path_tracer_for(uint32_t feature_bits);
 // The same paths, many at once: traces camera_rays[0, n) with samplers rngs[0, n) (each already
 // past its pixel and lens draws) and writes each path's radiance to out[i]. Rays go to Embree in
-// packets of 16. nullptr where the scalar loop must run (-H).
+// packets (Accel::intersect_many). nullptr where the scalar loop must run (-H).
 using PathBatchTracer = void (*)(const RenderScene&, const RenderParams&, const Ray* camera_rays, class Sampler* rngs,
                                  size_t n, Vec3* out, uint64_t& rays);
 PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const RenderParams& params);

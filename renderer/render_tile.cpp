@@ -1,5 +1,5 @@
 // A tile's samples for one pass: camera rays, the path loop (one path at a time, or many paths
-// in Embree packets of 16), and the per-pixel statistics every estimate and stop rule reads.
+// in Embree packets), and the per-pixel statistics every estimate and stop rule reads.
 #include <algorithm>
 
 #include "render.h"
