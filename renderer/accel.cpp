@@ -416,6 +416,13 @@ inline void to_lane(const Ray& r, RayK& e, int k) {
   e.mask[k] = 0xFFFFFFFFu, e.id[k] = 0, e.flags[k] = 0;
 }
 
+// The caller's rays, `stride` bytes apart.
+struct StridedRays {
+  const char* base;
+  size_t stride;
+  const Ray& operator[](size_t i) const { return *reinterpret_cast<const Ray*>(base + i * stride); }
+};
+
 // Which ray of the caller's array each lane of a packet of K holds, and Embree's valid mask.
 template <int K>
 struct Lanes {
@@ -423,8 +430,8 @@ struct Lanes {
   uint32_t ray[K];
   int used = 0;
 
-  template <class RayK>
-  bool add(const Ray* rays, uint32_t i, RayK& packet) {
+  template <class Rays, class RayK>
+  bool add(const Rays& rays, uint32_t i, RayK& packet) {
     to_lane(rays[i], packet, used);
     ray[used] = i;
     return ++used == K;
@@ -432,8 +439,8 @@ struct Lanes {
   // Before tracing: masked-off lanes of a partial packet also get a valid ray (a copy of lane 0).
   // Where the CPU lacks K-wide kernels Embree splits the packet, and its debug build asserted on
   // the stale rays of lanes it should ignore (seen under valgrind, which has no AVX-512).
-  template <class RayK>
-  void seal(const Ray* rays, RayK& packet) {
+  template <class Rays, class RayK>
+  void seal(const Rays& rays, RayK& packet) {
     for (int k = 0; k < K; ++k) valid[k] = k < used ? -1 : 0;
     for (int k = used; k < K; ++k) to_lane(rays[ray[0]], packet, k);
   }
@@ -462,15 +469,15 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
 namespace {
 
 template <int K>
-void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found);
+void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found);
 template <int K>
 void occluded_packets(const Accel::Impl& a, const Ray* rays, size_t n, uint8_t* blocked);
 
 }  // namespace
 
-void Accel::intersect_many(const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found) const {
-  if (m_impl->packet_width == 16) intersect_packets<16>(*m_impl, rays, n, hits, found);
-  else intersect_packets<8>(*m_impl, rays, n, hits, found);
+void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const {
+  if (m_impl->packet_width == 16) intersect_packets<16>(*m_impl, rays, stride, n, hits, found);
+  else intersect_packets<8>(*m_impl, rays, stride, n, hits, found);
 }
 
 void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {
@@ -488,30 +495,31 @@ void Accel::set_packet_width(int width) {
 namespace {
 
 template <int K>
-void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found) {
+void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   alignas(64) typename Packet<K>::RayHit rh;
   Lanes<K> lanes;
+  const StridedRays at{reinterpret_cast<const char*>(rays), stride};
   auto trace = [&] {
-    lanes.seal(rays, rh.ray);
+    lanes.seal(at, rh.ray);
     Packet<K>::intersect(lanes.valid, a.scene, &ctx, &rh);
     for (int k = 0; k < lanes.used; ++k) {
       const uint32_t i = lanes.ray[k];
       if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
       found[i] = 1;
-      refine_hit(a.geoms[rh.hit.geomID[k]], rays[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
+      refine_hit(a.geoms[rh.hit.geomID[k]], at[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
                  Vec3(rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]), hits[i]);
     }
     lanes.used = 0;
   };
   for (size_t i = 0; i < n; ++i) {
     found[i] = 0;
-    const Ray& r = rays[i];
+    const Ray& r = at[i];
     if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(r, 0);
     if (!embree_accepts(r) || (a.cull && !may_hit_bounds(r, a.lo, a.hi))) continue;
     rh.hit.geomID[lanes.used] = rh.hit.instID[0][lanes.used] = RTC_INVALID_GEOMETRY_ID;
-    if (lanes.add(rays, uint32_t(i), rh.ray)) trace();
+    if (lanes.add(at, uint32_t(i), rh.ray)) trace();
   }
   if (lanes.used) trace();
 }

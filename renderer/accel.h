@@ -48,7 +48,12 @@ class Accel {
   // is written where found[i]. Packet traversal may round a few hits differently from the
   // single-ray kernel (5 in 100,000 random rays in the last bit of t, u, v or Ng; none of them
   // turned a hit into a miss).
-  void intersect_many(const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found) const;
+  void intersect_many(const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found) const {
+    intersect_many(rays, sizeof(Ray), n, hits, found);
+  }
+  // The same with ray i at byte offset i * stride from `rays`: rays inside the caller's records
+  // (the path pool's states) are read where they are, not copied out first.
+  void intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const;
   void occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const;
   // Rays per Embree packet in intersect_many / occluded_many: Embree's native width, 16 on
   // AVX-512 and 8 below it. set_packet_width (8 or 16) overrides it, for tests and benchmarks.

@@ -259,7 +259,7 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
   };
   // Kept on the thread from call to call (one call per chunk of paths).
   static thread_local std::vector<LightPath> paths;
-  static thread_local std::vector<Ray> ray_buf, shadows;
+  static thread_local std::vector<Ray> shadows;
   static thread_local std::vector<SurfaceHit> hits(kSlots);
   static thread_local std::vector<uint8_t> found(kSlots), blocked;
   static thread_local std::vector<Pending> pending, made;
@@ -274,13 +274,11 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
     }
     const size_t m = paths.size();
     if (m == 0) break;
-    ray_buf.resize(m);
-    for (size_t i = 0; i < m; ++i) ray_buf[i] = paths[i].ray;
     rays += m;
-    if (params.ray_packets) {
-      scene.accel->intersect_many(ray_buf.data(), m, hits.data(), found.data());
+    if (params.ray_packets) {  // the rays where they lie in the paths, not copied out
+      scene.accel->intersect_many(&paths[0].ray, sizeof(LightPath), m, hits.data(), found.data());
     } else {
-      for (size_t i = 0; i < m; ++i) found[i] = scene.accel->intersect(ray_buf[i], hits[i]);
+      for (size_t i = 0; i < m; ++i) found[i] = scene.accel->intersect(paths[i].ray, hits[i]);
     }
     shadows.clear();
     pending.clear();

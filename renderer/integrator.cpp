@@ -281,20 +281,20 @@ struct PendingShadow {
   Vec3 contribution;
 };
 
-// path_step for the pool's slots `which`, all of them at a diffuse hit with depth left, in lanes
+// path_step for the pool's slots which[0, n), all of them at a diffuse hit with depth left, in lanes
 // (diffuse_lanes.h): the draws in path_step's order (light samples, the unused lobe number, the bounce,
 // roulette), light passes light by light, the bounce. The same bits as path_step.
-void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lanes::DiffuseVertices& v, const std::vector<uint32_t>& which,
-                      std::vector<PoolSlot>& slots, Sampler* rngs, const SurfaceHit* hits, uint8_t* alive,
+void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lanes::DiffuseVertices& v, const uint32_t* which,
+                      int n, std::vector<PoolSlot>& slots, Sampler* rngs, const SurfaceHit* hits, uint8_t* alive,
                       uint64_t& rays, std::vector<Ray>& shadow_rays, std::vector<PendingShadow>& shadows) {
-  const int n = int(which.size()), padded = (n + 7) & ~7;  // whole vectors of either width
+  const int padded = (n + 7) & ~7;  // whole vectors of either width
   const size_t nl = scene.lights.size() * size_t(params.light_samples);  // draws, light by light
   static thread_local std::vector<Vec2> u_light, u;
   static thread_local std::vector<Sampler*> samplers;
   u_light.resize(size_t(n) * nl);
   u.resize(size_t(n));
   samplers.resize(size_t(n));
-  for (int j = 0; j < n; ++j) samplers[size_t(j)] = &rngs[slots[which[size_t(j)]].job];
+  for (int j = 0; j < n; ++j) samplers[size_t(j)] = &rngs[slots[which[j]].job];
   // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
   // for all vertices at once: each sampler still sees its own draws in that order.
   for (size_t l = 0; l < nl; ++l) {
@@ -304,7 +304,7 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
   for (Sampler* rng : samplers) rng->skip_1d();
   Sampler::next_2d_many(samplers.data(), size_t(n), u.data(), params.simd_lanes);
   for (int j = 0; j < padded; ++j) {
-    const uint32_t i = which[size_t(j < n ? j : 0)];  // padding lanes repeat the first vertex
+    const uint32_t i = which[j < n ? j : 0];  // padding lanes repeat the first vertex
     PathState& st = slots[i].st;
     const SurfaceHit& h = hits[i];
     const Vec3 albedo = scene.materials[h.material].albedo;
@@ -351,13 +351,13 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
       r.tmin = 0;
       r.tmax = kShadowRayEnd;  // as spawn_ray_to
       PendingShadow& s = shadows[k++];
-      s.slot = which[size_t(j)];
+      s.slot = which[j];
       s.contribution = Vec3(v.cx[j], v.cy[j], v.cz[j]);
     }
   }
   lanes::bounce_pass(v, padded);
   for (int j = 0; j < n; ++j) {
-    const uint32_t i = which[size_t(j)];
+    const uint32_t i = which[j];
     PathState& st = slots[i].st;
     const int bounce = st.bounce++;
     alive[i] = v.alive[j] != 0;
@@ -390,9 +390,9 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   // would otherwise zero some 60 KB each time.
   struct Pool {
     std::unique_ptr<lanes::DiffuseVertices> lane_data;
-    std::vector<uint32_t> in_lanes;
+    std::vector<uint32_t> in_lanes = std::vector<uint32_t>(kSlots);
     std::vector<Slot> slots = std::vector<Slot>(kSlots);
-    std::vector<Ray> ray_buf = std::vector<Ray>(kSlots), shadow_rays;
+    std::vector<Ray> shadow_rays;
     std::vector<SurfaceHit> hits = std::vector<SurfaceHit>(kSlots);
     std::vector<uint8_t> found = std::vector<uint8_t>(kSlots), alive = std::vector<uint8_t>(kSlots), blocked;
     std::vector<Shadow> shadows;
@@ -403,7 +403,6 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   auto& lane_data = pool.lane_data;
   auto& in_lanes = pool.in_lanes;
   auto& slots = pool.slots;
-  auto& ray_buf = pool.ray_buf;
   auto& shadow_rays = pool.shadow_rays;
   auto& hits = pool.hits;
   auto& found = pool.found;
@@ -419,16 +418,16 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
     }
     if (live == 0) return;
     const size_t m = live;
-    for (size_t i = 0; i < m; ++i) ray_buf[i] = slots[i].st.ray;
     rays += m;
-    scene.accel->intersect_many(ray_buf.data(), m, hits.data(), found.data());
+    // The rays where they lie in the slots (PathState::ray), not copied out.
+    scene.accel->intersect_many(&slots[0].st.ray, sizeof(Slot), m, hits.data(), found.data());
     shadow_rays.clear();
     shadows.clear();
-    in_lanes.clear();
+    size_t n_lanes = 0;  // slots the lanes take: a diffuse hit with depth left
     for (size_t i = 0; i < m; ++i) {
       if (use_lanes && found[i] && slots[i].st.depth_left > 0 &&
           scene.materials[hits[i].material].type == MaterialType::diffuse) {
-        in_lanes.push_back(uint32_t(i));
+        in_lanes[n_lanes++] = uint32_t(i);
         continue;
       }
       auto shadow = [&](const SurfaceHit& hit, const LightSample& ls, Vec3 contribution) {
@@ -439,8 +438,9 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
       };
       alive[i] = path_step<F>(scene, params, slots[i].st, found[i] != 0, hits[i], rngs[slots[i].job], rays, shadow);
     }
-    if (!in_lanes.empty())
-      diffuse_in_lanes(scene, params, *lane_data, in_lanes, slots, rngs, hits.data(), alive.data(), rays, shadow_rays, shadows);
+    if (n_lanes)
+      diffuse_in_lanes(scene, params, *lane_data, in_lanes.data(), int(n_lanes), slots, rngs, hits.data(), alive.data(),
+                       rays, shadow_rays, shadows);
     blocked.resize(shadow_rays.size());
     scene.accel->occluded_many(shadow_rays.data(), shadow_rays.size(), blocked.data());
     for (size_t k = 0; k < shadows.size(); ++k)  // in order: each vertex sums its lights as the scalar loop does
