@@ -280,13 +280,24 @@ struct PendingShadow {
   uint32_t slot;
   Vec3 contribution;
 };
+// A pool step's shadow rays [0, n) and what each adds where unblocked. The arrays only grow and
+// their entries are written in place: resized every step, they would first store a default Ray
+// and PendingShadow (both have member initialisers) for every entry.
+struct ShadowBatch {
+  std::vector<Ray> rays;
+  std::vector<PendingShadow> pending;
+  size_t n = 0;
+  void make_room(size_t more) {
+    if (rays.size() < n + more) rays.resize(n + more), pending.resize(n + more);
+  }
+};
 
 // path_step for the pool's slots which[0, n), all of them at a diffuse hit with depth left, in lanes
 // (diffuse_lanes.h): the draws in path_step's order (light samples, the unused lobe number, the bounce,
 // roulette), light passes light by light, the bounce. The same bits as path_step.
 void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lanes::DiffuseVertices& v, const uint32_t* which,
                       int n, std::vector<PoolSlot>& slots, Sampler* rngs, const SurfaceHit* hits, uint8_t* alive,
-                      uint64_t& rays, std::vector<Ray>& shadow_rays, std::vector<PendingShadow>& shadows) {
+                      uint64_t& rays, ShadowBatch& shadows) {
   const int padded = (n + 7) & ~7;  // whole vectors of either width
   const size_t nl = scene.lights.size() * size_t(params.light_samples);  // draws, light by light
   static thread_local std::vector<Vec2> u_light, u;
@@ -338,22 +349,20 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
       }
     }
     lanes::light_pass(v, padded, light, params.light_samples);
-    size_t k = shadow_rays.size(), count = 0;
-    for (int j = 0; j < n; ++j) count += v.shadow[j] != 0;
-    shadow_rays.resize(k + count);
-    shadows.resize(k + count);
-    rays += count;
+    shadows.make_room(size_t(n));  // at most a shadow ray a vertex
+    const size_t first = shadows.n;
     for (int j = 0; j < n; ++j) {
       if (!v.shadow[j]) continue;
-      Ray& r = shadow_rays[k];
+      Ray& r = shadows.rays[shadows.n];
       r.o = Vec3(v.sox[j], v.soy[j], v.soz[j]);
       r.d = Vec3(v.sdx[j], v.sdy[j], v.sdz[j]);
       r.tmin = 0;
       r.tmax = kShadowRayEnd;  // as spawn_ray_to
-      PendingShadow& s = shadows[k++];
+      PendingShadow& s = shadows.pending[shadows.n++];
       s.slot = which[j];
       s.contribution = Vec3(v.cx[j], v.cy[j], v.cz[j]);
     }
+    rays += shadows.n - first;
   }
   lanes::bounce_pass(v, padded);
   for (int j = 0; j < n; ++j) {
@@ -392,10 +401,10 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
     std::unique_ptr<lanes::DiffuseVertices> lane_data;
     std::vector<uint32_t> in_lanes = std::vector<uint32_t>(kSlots);
     std::vector<Slot> slots = std::vector<Slot>(kSlots);
-    std::vector<Ray> shadow_rays;
+
     std::vector<SurfaceHit> hits = std::vector<SurfaceHit>(kSlots);
     std::vector<uint8_t> found = std::vector<uint8_t>(kSlots), alive = std::vector<uint8_t>(kSlots), blocked;
-    std::vector<Shadow> shadows;
+    ShadowBatch shadows;
   };
   static thread_local Pool pool;
   if (use_lanes && !pool.lane_data) pool.lane_data = std::make_unique<lanes::DiffuseVertices>();
@@ -403,7 +412,6 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   auto& lane_data = pool.lane_data;
   auto& in_lanes = pool.in_lanes;
   auto& slots = pool.slots;
-  auto& shadow_rays = pool.shadow_rays;
   auto& hits = pool.hits;
   auto& found = pool.found;
   auto& alive = pool.alive;
@@ -421,8 +429,7 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
     rays += m;
     // The rays where they lie in the slots (PathState::ray), not copied out.
     scene.accel->intersect_many(&slots[0].st.ray, sizeof(Slot), m, hits.data(), found.data());
-    shadow_rays.clear();
-    shadows.clear();
+    shadows.n = 0;
     size_t n_lanes = 0;  // slots the lanes take: a diffuse hit with depth left
     for (size_t i = 0; i < m; ++i) {
       if (use_lanes && found[i] && slots[i].st.depth_left > 0 &&
@@ -431,8 +438,9 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
         continue;
       }
       auto shadow = [&](const SurfaceHit& hit, const LightSample& ls, Vec3 contribution) {
-        shadow_ray(hit, ls, shadow_rays.emplace_back());  // in place: see spawn_ray
-        Shadow& s = shadows.emplace_back();
+        shadows.make_room(1);
+        shadow_ray(hit, ls, shadows.rays[shadows.n]);  // in place: see spawn_ray
+        Shadow& s = shadows.pending[shadows.n++];
         s.slot = uint32_t(i);
         s.contribution = contribution;
       };
@@ -440,11 +448,11 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
     }
     if (n_lanes)
       diffuse_in_lanes(scene, params, *lane_data, in_lanes.data(), int(n_lanes), slots, rngs, hits.data(), alive.data(),
-                       rays, shadow_rays, shadows);
-    blocked.resize(shadow_rays.size());
-    scene.accel->occluded_many(shadow_rays.data(), shadow_rays.size(), blocked.data());
-    for (size_t k = 0; k < shadows.size(); ++k)  // in order: each vertex sums its lights as the scalar loop does
-      if (!blocked[k]) slots[shadows[k].slot].st.direct_sum += shadows[k].contribution;
+                       rays, shadows);
+    if (blocked.size() < shadows.n) blocked.resize(shadows.n);
+    scene.accel->occluded_many(shadows.rays.data(), shadows.n, blocked.data());
+    for (size_t k = 0; k < shadows.n; ++k)  // in order: each vertex sums its lights as the scalar loop does
+      if (!blocked[k]) slots[shadows.pending[k].slot].st.direct_sum += shadows.pending[k].contribution;
     // A finished path's slot takes the next camera ray in place; once there are none, the last
     // slot moves into it (a copy of the whole state: only while the pool drains).
     for (size_t i = 0; i < live;) {
