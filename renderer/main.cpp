@@ -38,11 +38,9 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
               f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
-  if (o.params.ray_packets && !o.params.hemisphere)
-    std::printf("ray queries:      paths in Embree packets of %d\n", scene.accel->packet_width());
-  else
-    std::printf("ray queries:      one path at a time\n");
   const bool packets = o.params.ray_packets && !o.params.hemisphere;
+  if (packets) std::printf("ray queries:      paths in Embree packets of %d\n", scene.accel->packet_width());
+  else std::printf("ray queries:      one path at a time\n");
   const char* diffuse = !(packets && diffuse_lanes_apply(scene, o.params)) ? "one at a time"
                         : lanes::lane_width() == 8                        ? "eight at a time (AVX2 lanes)"
                                                                           : "four at a time (SSE2 lanes)";
