@@ -123,7 +123,9 @@ def test_killed_worker_loses_nothing_and_image_matches_single_process(cluster, s
     wait_for(lambda: api.get("/api/health").json()["workers"] == 3, "three workers announced")
     job_id = api.submit(JOB)["id"]
 
-    # Kill -9 a worker while it holds a pass (unacknowledged in the consumer group).
+    # Kill -9 a worker while it holds a pass (unacknowledged in the consumer group). First passes
+    # take milliseconds, so a worker seen holding one may ack it before the kill: it is stopped
+    # first, and killed only if it still holds the pass once stopped (else it goes on).
     victim, deadline = None, time.monotonic() + 60
     while victim is None:
         assert time.monotonic() < deadline, "no worker ever held a pass"
@@ -131,7 +133,14 @@ def test_killed_worker_loses_nothing_and_image_matches_single_process(cluster, s
         job = api.job(job_id)
         assert job["state"] in ("queued", "running"), job
         if job["samples"] > 0:
-            victim = next((w for w in workers if holding.get(w.name, 0) > 0), None)
+            candidate = next((w for w in workers if holding.get(w.name, 0) > 0), None)
+            if candidate is not None:
+                candidate.proc.send_signal(signal.SIGSTOP)
+                time.sleep(0.05)  # an ack already sent reaches Redis
+                if redis.pending_by_worker().get(candidate.name, 0) > 0:
+                    victim = candidate
+                else:
+                    candidate.proc.send_signal(signal.SIGCONT)
         time.sleep(0.02)
     victim.proc.send_signal(signal.SIGKILL)
     victim.proc.wait(10)
