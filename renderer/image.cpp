@@ -1,20 +1,18 @@
-// Tone mapping and image I/O (OpenImageIO). Files are written atomically: temp file, then rename.
+// Tone mapping, error measures, and the door to the image I/O module (image_module.h), loaded on
+// the first read or write. Not earlier on a thread: dlopen holds the loader's lock throughout, and
+// every thread created meanwhile (render threads, a server's pool) stalled for all of it.
 #include "image.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-#include <fcntl.h>
+#include <dlfcn.h>
 #include <unistd.h>
 
-#include <atomic>
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
+#include <cctype>
+#include <climits>
 #include <stdexcept>
 
-namespace pt {
+#include "image_module.h"
 
-namespace OIIO = OIIO_NAMESPACE;
+namespace pt {
 
 uint8_t tonemap_course(float v) {
   if (!(v > 0)) return 0;  // also maps NaN to black
@@ -52,46 +50,46 @@ std::vector<uint8_t> to_srgb8_course(const ImageRGB& img) {
 
 namespace {
 
-std::string temp_name(const std::string& path) {
-  static std::atomic<int> counter{0};
-  std::string dir, base = path;
-  size_t slash = path.find_last_of('/');
-  if (slash != std::string::npos) {
-    dir = path.substr(0, slash + 1);
-    base = path.substr(slash + 1);
-  }
-  return dir + "." + base + ".tmp" + std::to_string(getpid()) + "-" + std::to_string(counter++);
+std::string executable_dir() {
+  char buf[PATH_MAX];
+  ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+  if (n <= 0) return "";
+  std::string exe(buf, size_t(n));
+  return exe.substr(0, exe.find_last_of('/') + 1);
 }
 
-void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type, const void* data) {
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw std::runtime_error(path + ": cannot write this image format (" + OIIO::geterror() + ")");
-  std::string tmp = temp_name(path);
-  errno = 0;
-  if (!out->open(tmp, spec) || !out->write_image(type, data) || !out->close()) {
-    // OpenImageIO's message does not say why a write failed: the system's reason does (full disk,
-    // file-size limit, read-only or vanished folder).
-    int why = errno;
-    std::string err = out->geterror();
-    if (why == ENOSPC || why == EFBIG || why == EDQUOT || why == EROFS || why == EIO || why == ENOENT || why == ENOTDIR ||
-        why == EACCES)
-      err += std::string(err.empty() ? "" : " ") + "(" + std::strerror(why) + ")";
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot write image: " + err);
+// Next to the executable first (a copied pair of files works), then where the build put it.
+std::vector<std::string> module_paths() {
+  std::vector<std::string> paths = {executable_dir() + "pt_imageio.so"};
+  if (paths[0] != PT_IMAGEIO_MODULE) paths.push_back(PT_IMAGEIO_MODULE);
+  return paths;
+}
+
+const char* kUnavailable = "image I/O is unavailable: cannot load the OpenImageIO module pt_imageio.so";
+
+const ImageModule* load_module() {
+  std::string tried;
+  for (const std::string& path : module_paths()) {
+    if (access(path.c_str(), R_OK) != 0) {
+      tried += "\n  " + path + ": absent";
+      continue;
+    }
+    void* handle = dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL);
+    if (!handle) {
+      tried += "\n  " + path + ": " + dlerror();
+      continue;
+    }
+    auto entry = reinterpret_cast<const ImageModule* (*)()>(dlsym(handle, "pt_image_module"));
+    const ImageModule* m = entry ? entry() : nullptr;
+    if (m && m->abi == kImageModuleAbi) return m;  // never closed: OpenImageIO keeps state
+    tried += "\n  " + path + ": not a pt_imageio module of this build (rebuild it)";
   }
-  // On the disk before the rename: after a crash the name holds the old file or the whole new one.
-  int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0 || ::fsync(fd) != 0) {
-    std::string err = std::strerror(errno);
-    if (fd >= 0) ::close(fd);
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot write image: " + err);
-  }
-  ::close(fd);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot move the finished image into place");
-  }
+  throw std::runtime_error(kUnavailable + tried);
+}
+
+const ImageModule& module() {
+  static const ImageModule* m = load_module();  // a failed load throws and is retried next call
+  return *m;
 }
 
 bool ends_with(const std::string& s, const std::string& suffix) {
@@ -103,76 +101,30 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 }  // namespace
 
+void require_image_io() {
+  std::string tried;
+  for (const std::string& path : module_paths()) {
+    if (access(path.c_str(), R_OK) == 0) return;
+    tried += "\n  " + path + ": absent";
+  }
+  throw std::runtime_error(kUnavailable + tried);
+}
+
 void write_png8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path) {
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  write_atomic(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+  module().write_rgb8(rgb, width, height, path, {});
 }
 
 void write_image(const ImageRGB& img, const std::string& path, const Metadata& meta) {
-  if (ends_with(path, ".exr")) {
-    OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
-    spec.attribute("compression", "zip");
-    for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
-    write_atomic(path, spec, OIIO::TypeDesc::FLOAT, img.pixels.data());
-    return;
-  }
-  std::vector<uint8_t> rgb = to_srgb8_course(img);
-  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
-  for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
-  write_atomic(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+  if (ends_with(path, ".exr")) module().write_exr(img, path, meta);
+  else module().write_rgb8(to_srgb8_course(img), img.width, img.height, path, meta);
 }
 
 std::string encode_png8(const std::vector<uint8_t>& rgb, int width, int height) {
-  std::vector<unsigned char> buffer;
-  OIIO::Filesystem::IOVecOutput vec(buffer);
-  auto out = OIIO::ImageOutput::create("tile.png");
-  if (!out) throw std::runtime_error("PNG encoder unavailable");
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  OIIO::Filesystem::IOProxy* proxy = &vec;
-  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  spec.attribute("png:compressionLevel", 3);
-  if (!out->open("tile.png", spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
-    throw std::runtime_error("PNG encoding failed: " + out->geterror());
-  return std::string(buffer.begin(), buffer.end());
+  return module().encode_png8(rgb, width, height);
 }
 
-std::string encode_exr(const ImageRGB& img, const Metadata& meta) {
-  std::vector<unsigned char> buffer;
-  OIIO::Filesystem::IOVecOutput vec(buffer);
-  auto out = OIIO::ImageOutput::create("image.exr");
-  if (!out) throw std::runtime_error("EXR encoder unavailable");
-  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
-  spec.attribute("compression", "zip");
-  for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
-  OIIO::Filesystem::IOProxy* proxy = &vec;
-  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  if (!out->supports("ioproxy")) throw std::runtime_error("this OpenImageIO cannot write EXR to memory");
-  if (!out->open("image.exr", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, img.pixels.data()) || !out->close())
-    throw std::runtime_error("EXR encoding failed: " + out->geterror());
-  return std::string(buffer.begin(), buffer.end());
-}
+std::string encode_exr(const ImageRGB& img, const Metadata& meta) { return module().encode_exr(img, meta); }
 
-ImageRGB read_image(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw std::runtime_error(path + ": cannot read image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || int64_t(spec.width) * spec.height > (int64_t(1) << 28))
-    throw std::runtime_error(path + ": image size is not usable");
-  std::vector<float> data(size_t(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data()))
-    throw std::runtime_error(path + ": cannot read pixels: " + in->geterror());
-  int ch[3] = {0, spec.nchannels > 1 ? 1 : 0, spec.nchannels > 2 ? 2 : 0};
-  const char* names[3] = {"R", "G", "B"};
-  for (int c = 0; c < 3; ++c)
-    for (int i = 0; i < spec.nchannels; ++i)
-      if (spec.channelnames.size() > size_t(i) && spec.channelnames[i] == names[c]) ch[c] = i;
-  ImageRGB img;
-  img.width = spec.width;
-  img.height = spec.height;
-  img.pixels.resize(size_t(spec.width) * spec.height);
-  for (size_t p = 0; p < img.pixels.size(); ++p)
-    img.pixels[p] = Vec3(data[p * spec.nchannels + ch[0]], data[p * spec.nchannels + ch[1]], data[p * spec.nchannels + ch[2]]);
-  return img;
-}
+ImageRGB read_image(const std::string& path) { return module().read_image(path); }
 
 }  // namespace pt

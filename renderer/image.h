@@ -1,4 +1,5 @@
-// Film images, the course's tone mapping, and all image I/O through OpenImageIO.
+// Film images, the course's tone mapping, and all image I/O through OpenImageIO (loaded on the
+// first read or write: image_module.h).
 #pragma once
 
 #include <string>
@@ -39,5 +40,8 @@ std::string encode_png8(const std::vector<uint8_t>& rgb, int width, int height);
 std::string encode_exr(const ImageRGB& img, const Metadata& meta = {});
 // Reads any image OpenImageIO can read as linear RGB float (top row first); throws on failure.
 ImageRGB read_image(const std::string& path);
+// Throws, naming where it looked, when the image module is not there, without loading it: called
+// before a render whose image would otherwise be lost to a missing module at the end.
+void require_image_io();
 
 }  // namespace pt

@@ -74,6 +74,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   try {
+    if (!o.describe) require_image_io();
     auto t0 = std::chrono::steady_clock::now();
     SceneDesc desc = load_collada(o.scene_path);
     auto scene = make_render_scene(desc, o.params);

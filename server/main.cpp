@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "connection.h"
+#include "image.h"
 #include "jobs.h"
 #include "routes.h"
 
@@ -108,6 +109,7 @@ int main(int argc, char** argv) {
 
   srv::JobManager jobs(cfg);
   try {
+    pt::require_image_io();  // every job ends in an image: refuse to start rather than lose them
     jobs.start();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "render-server: %s\n", e.what());

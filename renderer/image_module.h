@@ -1,0 +1,34 @@
+// The image I/O module's interface. OpenImageIO on Debian 12 pulls in about 260 shared libraries
+// (OpenCV, GDAL, FFmpeg, GStreamer, ...), and loading them took 0.35-0.45 s at every process start:
+// `pathtracer --help` spent that long, and so did every test process and the server. So all
+// OpenImageIO code lives in a module, pt_imageio.so (image_oiio.cpp), that image.cpp loads with
+// dlopen on the first read or write, or earlier in the background (preload_image_io).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "image.h"
+
+namespace pt {
+
+// Bumped whenever the table below changes, so a stale module is refused by name, not called.
+constexpr uint32_t kImageModuleAbi = 1;
+
+struct ImageModule {
+  uint32_t abi;
+  // Linear float EXR with metadata, written atomically (temp file, fsync, rename).
+  void (*write_exr)(const ImageRGB& img, const std::string& path, const Metadata& meta);
+  // 8-bit RGB rows (top first) in whatever format the extension names, written atomically.
+  void (*write_rgb8)(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path,
+                     const Metadata& meta);
+  std::string (*encode_png8)(const std::vector<uint8_t>& rgb, int width, int height);
+  std::string (*encode_exr)(const ImageRGB& img, const Metadata& meta);
+  ImageRGB (*read_image)(const std::string& path);
+};
+
+}  // namespace pt
+
+// The module's one exported symbol.
+extern "C" const pt::ImageModule* pt_image_module();

@@ -1,0 +1,138 @@
+// The OpenImageIO module (image_module.h): every image read and write, loaded on first use so that
+// processes that never touch an image skip OpenImageIO's dependency tree. Files are written
+// atomically: temp file, fsync, then rename.
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#include "image_module.h"
+
+// Named apart from image.h's functions of the same names, which forward here.
+namespace pt::oiio_module {
+
+namespace OIIO = OIIO_NAMESPACE;
+
+std::string temp_name(const std::string& path) {
+  static std::atomic<int> counter{0};
+  std::string dir, base = path;
+  size_t slash = path.find_last_of('/');
+  if (slash != std::string::npos) {
+    dir = path.substr(0, slash + 1);
+    base = path.substr(slash + 1);
+  }
+  return dir + "." + base + ".tmp" + std::to_string(getpid()) + "-" + std::to_string(counter++);
+}
+
+void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type, const void* data) {
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw std::runtime_error(path + ": cannot write this image format (" + OIIO::geterror() + ")");
+  std::string tmp = temp_name(path);
+  errno = 0;
+  if (!out->open(tmp, spec) || !out->write_image(type, data) || !out->close()) {
+    // OpenImageIO's message does not say why a write failed: the system's reason does (full disk,
+    // file-size limit, read-only or vanished folder).
+    int why = errno;
+    std::string err = out->geterror();
+    if (why == ENOSPC || why == EFBIG || why == EDQUOT || why == EROFS || why == EIO || why == ENOENT || why == ENOTDIR ||
+        why == EACCES)
+      err += std::string(err.empty() ? "" : " ") + "(" + std::strerror(why) + ")";
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot write image: " + err);
+  }
+  // On the disk before the rename: after a crash the name holds the old file or the whole new one.
+  int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    std::string err = std::strerror(errno);
+    if (fd >= 0) ::close(fd);
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot write image: " + err);
+  }
+  ::close(fd);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot move the finished image into place");
+  }
+}
+
+void write_exr(const ImageRGB& img, const std::string& path, const Metadata& meta) {
+  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
+  spec.attribute("compression", "zip");
+  for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
+  write_atomic(path, spec, OIIO::TypeDesc::FLOAT, img.pixels.data());
+}
+
+void write_rgb8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path,
+                const Metadata& meta) {
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
+  write_atomic(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+}
+
+std::string encode_png8(const std::vector<uint8_t>& rgb, int width, int height) {
+  std::vector<unsigned char> buffer;
+  OIIO::Filesystem::IOVecOutput vec(buffer);
+  auto out = OIIO::ImageOutput::create("tile.png");
+  if (!out) throw std::runtime_error("PNG encoder unavailable");
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  OIIO::Filesystem::IOProxy* proxy = &vec;
+  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  spec.attribute("png:compressionLevel", 3);
+  if (!out->open("tile.png", spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
+    throw std::runtime_error("PNG encoding failed: " + out->geterror());
+  return std::string(buffer.begin(), buffer.end());
+}
+
+std::string encode_exr(const ImageRGB& img, const Metadata& meta) {
+  std::vector<unsigned char> buffer;
+  OIIO::Filesystem::IOVecOutput vec(buffer);
+  auto out = OIIO::ImageOutput::create("image.exr");
+  if (!out) throw std::runtime_error("EXR encoder unavailable");
+  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
+  spec.attribute("compression", "zip");
+  for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
+  OIIO::Filesystem::IOProxy* proxy = &vec;
+  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  if (!out->supports("ioproxy")) throw std::runtime_error("this OpenImageIO cannot write EXR to memory");
+  if (!out->open("image.exr", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, img.pixels.data()) || !out->close())
+    throw std::runtime_error("EXR encoding failed: " + out->geterror());
+  return std::string(buffer.begin(), buffer.end());
+}
+
+ImageRGB read_image(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw std::runtime_error(path + ": cannot read image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || int64_t(spec.width) * spec.height > (int64_t(1) << 28))
+    throw std::runtime_error(path + ": image size is not usable");
+  std::vector<float> data(size_t(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data()))
+    throw std::runtime_error(path + ": cannot read pixels: " + in->geterror());
+  int ch[3] = {0, spec.nchannels > 1 ? 1 : 0, spec.nchannels > 2 ? 2 : 0};
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < spec.nchannels; ++i)
+      if (spec.channelnames.size() > size_t(i) && spec.channelnames[i] == names[c]) ch[c] = i;
+  ImageRGB img;
+  img.width = spec.width;
+  img.height = spec.height;
+  img.pixels.resize(size_t(spec.width) * spec.height);
+  for (size_t p = 0; p < img.pixels.size(); ++p)
+    img.pixels[p] = Vec3(data[p * spec.nchannels + ch[0]], data[p * spec.nchannels + ch[1]], data[p * spec.nchannels + ch[2]]);
+  return img;
+}
+
+}  // namespace pt::oiio_module
+
+extern "C" __attribute__((visibility("default"))) const pt::ImageModule* pt_image_module() {
+  namespace m = pt::oiio_module;
+  static const pt::ImageModule table = {pt::kImageModuleAbi, m::write_exr,  m::write_rgb8,
+                                        m::encode_png8,      m::encode_exr, m::read_image};
+  return &table;
+}
