@@ -2,6 +2,7 @@
 // framing (480x360 keep_fov, light_samples 1, no adaptive sampling). Numbers only.
 //
 //   bench_scaling [--spp 16] [--runs 3] [--scene NAME] [--sampler sobol|independent] [--depth M] [--smoke]
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -59,15 +60,22 @@ int main(int argc, char** argv) {
         rps[t].push_back(s.stats().rays / s.stats().seconds);
         bar.update(double(++done) / total);
       }
+    // Each run's 2-thread rate over the 1-thread rate just before it, then the median: pairs cancel
+    // the machine's slow drift, which a ratio of two medians does not; min-max shows the spread.
+    std::vector<double> paired;
+    for (int r = 0; r < runs; ++r) paired.push_back(sps[1][size_t(r)] / sps[0][size_t(r)]);
+    const auto [lo, hi] = std::minmax_element(paired.begin(), paired.end());
     char line[256];
-    std::snprintf(line, sizeof line, "%-10s %4d %10.3f M %10.3f M %7.2f %10.2f M %10.2f M", sc.name.c_str(),
-                  p.max_depth, median(sps[0]) / 1e6, median(sps[1]) / 1e6, median(sps[1]) / median(sps[0]),
+    std::snprintf(line, sizeof line, "%-10s %4d %10.3f M %10.3f M %7.2f %4.2f-%4.2f %10.2f M %10.2f M", sc.name.c_str(),
+                  p.max_depth, median(sps[0]) / 1e6, median(sps[1]) / 1e6, median(paired), *lo, *hi,
                   median(rps[0]) / 1e6, median(rps[1]) / 1e6);
     table.push_back(line);
   }
   bar.finish();
-  std::printf("%-10s %4s %12s %12s %7s %12s %12s\n", "scene", "m", "samples/s 1t", "samples/s 2t", "2t/1t",
-              "rays/s 1t", "rays/s 2t");
+  std::printf("%-10s %4s %12s %12s %7s %9s %12s %12s\n", "scene", "m", "samples/s 1t", "samples/s 2t", "2t/1t",
+              "min-max", "rays/s 1t", "rays/s 2t");
   for (const std::string& l : table) std::printf("%s\n", l.c_str());
+  std::printf("2t/1t = median over runs of the 2-thread samples/s over the 1-thread samples/s of the same run "
+              "(min-max: the smallest and largest of those runs)\n");
   return 0;
 }
