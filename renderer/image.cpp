@@ -60,8 +60,10 @@ std::string executable_dir() {
 
 // Next to the executable first (a copied pair of files works), then where the build put it.
 std::vector<std::string> module_paths() {
-  std::vector<std::string> paths = {executable_dir() + "pt_imageio.so"};
-  if (paths[0] != PT_IMAGEIO_MODULE) paths.push_back(PT_IMAGEIO_MODULE);
+  std::vector<std::string> paths;
+  std::string dir = executable_dir();  // empty if /proc is not mounted: never a path relative to the cwd
+  if (!dir.empty() && dir + "pt_imageio.so" != PT_IMAGEIO_MODULE) paths.push_back(dir + "pt_imageio.so");
+  paths.push_back(PT_IMAGEIO_MODULE);
   return paths;
 }
 

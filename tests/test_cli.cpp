@@ -9,6 +9,7 @@
 
 #include <OpenImageIO/imageio.h>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -31,8 +32,8 @@ struct RunResult {
   std::string output;
 };
 
-RunResult run(const std::string& args) {
-  std::string cmd = std::string(PT_PATHTRACER) + " " + args + " 2>&1";
+RunResult run(const std::string& args, const std::string& binary = PT_PATHTRACER) {
+  std::string cmd = binary + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   char buf[4096];
@@ -180,6 +181,34 @@ TEST(Cli, BadSceneFailsWithALocatedMessage) {
   r = run("--quiet -f " + test::temp_dir() + "/never.png /nonexistent/scene.dae");
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("/nonexistent/scene.dae"), std::string::npos) << r.output;
+}
+
+// The image module (renderer/image_module.h) is looked for beside the executable first, then where
+// the build put it: a copied pair works, and a broken copy falls back to the built one.
+TEST(Cli, ImageModuleBesideTheBinaryFirstThenTheBuiltOne) {
+  std::string build_dir = PT_PATHTRACER;
+  build_dir.resize(build_dir.find_last_of('/') + 1);
+  std::string dir = test::temp_dir() + "/relocated/";
+  std::filesystem::create_directories(dir);
+  auto copy = [](const std::string& from, const std::string& to) {
+    std::filesystem::copy_file(from, to, std::filesystem::copy_options::overwrite_existing);
+  };
+  copy(PT_PATHTRACER, dir + "pathtracer");
+  copy(build_dir + "pt_imageio.so", dir + "pt_imageio.so");
+  std::string scene = write_tiny_scene(), out = dir + "moved.png";
+  // LD_DEBUG=files names each library as it is loaded.
+  RunResult r = run("-s 1 -r 16 12 --quiet -f " + out + " " + scene, "LD_DEBUG=files " + dir + "pathtracer");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("file=" + dir + "pt_imageio.so"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("file=" + build_dir + "pt_imageio.so"), std::string::npos) << r.output;
+  EXPECT_TRUE(test::file_exists(out));
+
+  std::ofstream(dir + "pt_imageio.so", std::ios::trunc) << "not a shared object";
+  std::remove(out.c_str());
+  r = run("-s 1 -r 16 12 --quiet -f " + out + " " + scene, "LD_DEBUG=files " + dir + "pathtracer");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("file=" + build_dir + "pt_imageio.so"), std::string::npos) << r.output;
+  EXPECT_TRUE(test::file_exists(out));
 }
 
 TEST(Cli, MoreThreadsThanCoresStillWork) {
