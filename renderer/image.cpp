@@ -6,8 +6,11 @@
 #include <dlfcn.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <climits>
+#include <cstring>
 #include <stdexcept>
 
 #include "image_module.h"
@@ -110,6 +113,16 @@ void require_image_io() {
     tried += "\n  " + path + ": absent";
   }
   throw std::runtime_error(kUnavailable + tried);
+}
+
+void check_image_output(const std::string& path) {
+  std::string why = module().writer_problem(path);
+  if (!why.empty()) throw std::runtime_error(path + ": " + why);
+  size_t slash = path.find_last_of('/');
+  std::string dir = slash == std::string::npos ? "." : path.substr(0, std::max<size_t>(slash, 1));
+  // The image goes to a temporary file in this folder, then is renamed: it must take new files.
+  if (access(dir.c_str(), W_OK | X_OK) != 0)
+    throw std::runtime_error(path + ": cannot write into the folder " + dir + " (" + std::strerror(errno) + ")");
 }
 
 void write_png8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path) {

@@ -41,7 +41,11 @@ std::string encode_exr(const ImageRGB& img, const Metadata& meta = {});
 // Reads any image OpenImageIO can read as linear RGB float (top row first); throws on failure.
 ImageRGB read_image(const std::string& path);
 // Throws, naming where it looked, when the image module is not there, without loading it: called
-// before a render whose image would otherwise be lost to a missing module at the end.
+// before renders whose images would otherwise be lost to a missing module at the end.
 void require_image_io();
+// Throws, naming the path, unless an image can be written there: a known format and a folder that
+// takes files. Loads the module (before any render thread exists: image_module.h), so that a
+// render never runs for hours only to find it cannot be saved.
+void check_image_output(const std::string& path);
 
 }  // namespace pt

@@ -14,7 +14,7 @@
 namespace pt {
 
 // Bumped whenever the table below changes, so a stale module is refused by name, not called.
-constexpr uint32_t kImageModuleAbi = 1;
+constexpr uint32_t kImageModuleAbi = 2;
 
 struct ImageModule {
   uint32_t abi;
@@ -26,6 +26,8 @@ struct ImageModule {
   std::string (*encode_png8)(const std::vector<uint8_t>& rgb, int width, int height);
   std::string (*encode_exr)(const ImageRGB& img, const Metadata& meta);
   ImageRGB (*read_image)(const std::string& path);
+  // Empty when there is a writer for the path's format, else why not (nothing is written).
+  std::string (*writer_problem)(const std::string& path);
 };
 
 }  // namespace pt

@@ -128,11 +128,16 @@ ImageRGB read_image(const std::string& path) {
   return img;
 }
 
+std::string writer_problem(const std::string& path) {
+  if (OIIO::ImageOutput::create(path)) return "";
+  return "cannot write this image format (" + OIIO::geterror() + ")";
+}
+
 }  // namespace pt::oiio_module
 
 extern "C" __attribute__((visibility("default"))) const pt::ImageModule* pt_image_module() {
   namespace m = pt::oiio_module;
-  static const pt::ImageModule table = {pt::kImageModuleAbi, m::write_exr,  m::write_rgb8,
-                                        m::encode_png8,      m::encode_exr, m::read_image};
+  static const pt::ImageModule table = {pt::kImageModuleAbi, m::write_exr,  m::write_rgb8,    m::encode_png8,
+                                        m::encode_exr,       m::read_image, m::writer_problem};
   return &table;
 }

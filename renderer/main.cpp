@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   try {
-    if (!o.describe) require_image_io();
+    if (!o.describe) check_image_output(o.output);  // before the render, not after it
     auto t0 = std::chrono::steady_clock::now();
     SceneDesc desc = load_collada(o.scene_path);
     auto scene = make_render_scene(desc, o.params);

@@ -183,6 +183,22 @@ TEST(Cli, BadSceneFailsWithALocatedMessage) {
   EXPECT_NE(r.output.find("/nonexistent/scene.dae"), std::string::npos) << r.output;
 }
 
+// An image that could not be saved fails the command at once, before the scene loads ("Loaded ..."
+// is never printed), not after the render.
+TEST(Cli, AnUnwritableOutputFailsBeforeTheRender) {
+  std::string scene = write_tiny_scene(), dir = test::temp_dir();
+  RunResult r = run("-s 4 -r 64 48 -f " + dir + "/out.notaformat " + scene);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("out.notaformat: cannot write this image format"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("Loaded"), std::string::npos) << r.output;
+
+  r = run("-s 4 -r 64 48 -f " + dir + "/no_such_folder/out.png " + scene);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("cannot write into the folder " + dir + "/no_such_folder"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("Loaded"), std::string::npos) << r.output;
+  EXPECT_FALSE(test::file_exists(dir + "/no_such_folder"));
+}
+
 // The image module (renderer/image_module.h) is looked for beside the executable first, then where
 // the build put it: a copied pair works, and a broken copy falls back to the built one.
 TEST(Cli, ImageModuleBesideTheBinaryFirstThenTheBuiltOne) {
