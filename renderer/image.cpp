@@ -61,24 +61,25 @@ std::string executable_dir() {
   return exe.substr(0, exe.find_last_of('/') + 1);
 }
 
-// Next to the executable first (a copied pair of files works), then where the build put it.
-std::vector<std::string> module_paths() {
-  std::vector<std::string> paths;
+// The module files that exist, next to the executable first (a copied pair of files works), then
+// where the build put it; each absent one adds a line to `tried`, for the error.
+std::vector<std::string> present_module_paths(std::string& tried) {
+  std::vector<std::string> candidates, present;
   std::string dir = executable_dir();  // empty if /proc is not mounted: never a path relative to the cwd
-  if (!dir.empty() && dir + "pt_imageio.so" != PT_IMAGEIO_MODULE) paths.push_back(dir + "pt_imageio.so");
-  paths.push_back(PT_IMAGEIO_MODULE);
-  return paths;
+  if (!dir.empty() && dir + "pt_imageio.so" != PT_IMAGEIO_MODULE) candidates.push_back(dir + "pt_imageio.so");
+  candidates.push_back(PT_IMAGEIO_MODULE);
+  for (const std::string& path : candidates) {
+    if (access(path.c_str(), R_OK) == 0) present.push_back(path);
+    else tried += "\n  " + path + ": absent";
+  }
+  return present;
 }
 
 const char* kUnavailable = "image I/O is unavailable: cannot load the OpenImageIO module pt_imageio.so";
 
 const ImageModule* load_module() {
   std::string tried;
-  for (const std::string& path : module_paths()) {
-    if (access(path.c_str(), R_OK) != 0) {
-      tried += "\n  " + path + ": absent";
-      continue;
-    }
+  for (const std::string& path : present_module_paths(tried)) {
     void* handle = dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL);
     if (!handle) {
       tried += "\n  " + path + ": " + dlerror();
@@ -108,11 +109,7 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 void require_image_io() {
   std::string tried;
-  for (const std::string& path : module_paths()) {
-    if (access(path.c_str(), R_OK) == 0) return;
-    tried += "\n  " + path + ": absent";
-  }
-  throw std::runtime_error(kUnavailable + tried);
+  if (present_module_paths(tried).empty()) throw std::runtime_error(kUnavailable + tried);
 }
 
 void check_image_output(const std::string& path) {
