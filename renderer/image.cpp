@@ -4,6 +4,7 @@
 #include "image.h"
 
 #include <dlfcn.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -117,9 +118,14 @@ void check_image_output(const std::string& path) {
   if (!why.empty()) throw std::runtime_error(path + ": " + why);
   size_t slash = path.find_last_of('/');
   std::string dir = slash == std::string::npos ? "." : path.substr(0, std::max<size_t>(slash, 1));
-  // The image goes to a temporary file in this folder, then is renamed: it must take new files.
-  if (access(dir.c_str(), W_OK | X_OK) != 0)
+  // The image goes to a temporary file in this folder, then is renamed: it must take new files. A
+  // probe file, not access(), which root passes on some read-only mounts (docs/reliability.md).
+  std::string probe = dir + "/.pathtracer-probe-" + std::to_string(getpid());
+  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0)
     throw std::runtime_error(path + ": cannot write into the folder " + dir + " (" + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 void write_png8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path) {
