@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
     if (depth >= 0) p.max_depth = depth;
     p.spp = spp;
     auto scene = make_render_scene(desc, p);
-    std::vector<double> sps[2], rps[2];
+    std::vector<double> sps[2], rps[2], busy[2], per_cpu[2];
     for (int r = 0; r < runs; ++r)
       for (int t = 0; t < 2; ++t) {  // interleaved, so drift hits both alike
         RenderParams pt = p;
@@ -58,24 +58,31 @@ int main(int argc, char** argv) {
         s.render_pass(spp);
         sps[t].push_back(s.stats().samples / s.stats().seconds);
         rps[t].push_back(s.stats().rays / s.stats().seconds);
+        busy[t].push_back(s.stats().cpu_seconds / ((t + 1) * s.stats().seconds));
+        per_cpu[t].push_back(s.stats().samples / s.stats().cpu_seconds);
         bar.update(double(++done) / total);
       }
     // Each run's 2-thread rate over the 1-thread rate just before it, then the median: pairs cancel
     // the machine's slow drift, which a ratio of two medians does not; min-max shows the spread.
-    std::vector<double> paired;
-    for (int r = 0; r < runs; ++r) paired.push_back(sps[1][size_t(r)] / sps[0][size_t(r)]);
+    std::vector<double> paired, paired_cpu;
+    for (int r = 0; r < runs; ++r) {
+      paired.push_back(sps[1][size_t(r)] / sps[0][size_t(r)]);
+      paired_cpu.push_back(per_cpu[1][size_t(r)] / per_cpu[0][size_t(r)]);
+    }
     const auto [lo, hi] = std::minmax_element(paired.begin(), paired.end());
     char line[256];
-    std::snprintf(line, sizeof line, "%-10s %4d %10.3f M %10.3f M %7.2f %4.2f-%4.2f %10.2f M %10.2f M", sc.name.c_str(),
-                  p.max_depth, median(sps[0]) / 1e6, median(sps[1]) / 1e6, median(paired), *lo, *hi,
-                  median(rps[0]) / 1e6, median(rps[1]) / 1e6);
+    std::snprintf(line, sizeof line, "%-10s %4d %10.3f M %10.3f M %7.2f %4.2f-%4.2f %10.2f M %10.2f M %8.2f %8.2f %9.2f",
+                  sc.name.c_str(), p.max_depth, median(sps[0]) / 1e6, median(sps[1]) / 1e6, median(paired), *lo, *hi,
+                  median(rps[0]) / 1e6, median(rps[1]) / 1e6, median(busy[0]), median(busy[1]), median(paired_cpu));
     table.push_back(line);
   }
   bar.finish();
-  std::printf("%-10s %4s %12s %12s %7s %9s %12s %12s\n", "scene", "m", "samples/s 1t", "samples/s 2t", "2t/1t",
-              "min-max", "rays/s 1t", "rays/s 2t");
+  std::printf("%-10s %4s %12s %12s %7s %9s %12s %12s %8s %8s %9s\n", "scene", "m", "samples/s 1t", "samples/s 2t", "2t/1t",
+              "min-max", "rays/s 1t", "rays/s 2t", "busy 1t", "busy 2t", "per-CPU");
   for (const std::string& l : table) std::printf("%s\n", l.c_str());
   std::printf("2t/1t = median over runs of the 2-thread samples/s over the 1-thread samples/s of the same run "
-              "(min-max: the smallest and largest of those runs)\n");
+              "(min-max: the smallest and largest of those runs); busy = the render threads' CPU time over threads x wall "
+              "time (below 1: threads waited for a core, or for each other at the pass's end); per-CPU = the same paired "
+              "ratio of samples per CPU-second (1.00: two threads do not slow each other down)\n");
   return 0;
 }

@@ -180,6 +180,9 @@ struct SessionStats {
   uint64_t samples = 0, rays = 0, nonfinite = 0;
   uint64_t light_paths = 0;  // caustic light paths traced (caustics.h)
   double seconds = 0;
+  // CPU time the render threads spent in passes, summed over threads: against threads x seconds it
+  // tells a slow host (threads that waited for a core) from a slow render (bench_scaling).
+  double cpu_seconds = 0;
   int passes = 0;
 };
 
@@ -283,6 +286,7 @@ class RenderSession {
   uint64_t m_lt_paths = 0, m_lt_half_paths = 0, m_lt_issued = 0;
   std::atomic<uint64_t> m_samples{0}, m_rays{0}, m_nonfinite{0};
   std::atomic<uint64_t> m_budget_done{0};  // pixel-samples done, converged pixels counted in full
+  std::atomic<uint64_t> m_cpu_ns{0};      // SessionStats::cpu_seconds
   double m_seconds = 0;
   int m_passes = 0;
   std::chrono::steady_clock::time_point m_deadline = std::chrono::steady_clock::time_point::max();

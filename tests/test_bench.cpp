@@ -65,7 +65,17 @@ TEST(BenchSmoke, Scaling) {
   std::string out;
   ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --smoke --runs 3", out), 0) << out;
   EXPECT_NE(out.find("samples/s 1t samples/s 2t   2t/1t   min-max"), std::string::npos) << out;
+  EXPECT_NE(out.find("busy 1t  busy 2t   per-CPU"), std::string::npos) << out;
   expect_median_within_spread(out, 1);  // smoke: dof.dae only
+  // busy (CPU over threads x wall time) lies in (0, 1]; per-CPU (a ratio of rates) is positive.
+  std::smatch m;
+  std::regex tail(R"( M +(\d+\.\d\d) +(\d+\.\d\d) +(\d+\.\d\d)\n)");
+  ASSERT_TRUE(std::regex_search(out, m, tail)) << out;
+  for (int k : {1, 2}) {
+    EXPECT_GT(std::stod(m[k]), 0) << m.str();
+    EXPECT_LE(std::stod(m[k]), 1.02) << m.str();
+  }
+  EXPECT_GT(std::stod(m[3]), 0) << m.str();
 }
 
 TEST(BenchSmoke, UnknownFlagIsRefused) {

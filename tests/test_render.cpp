@@ -258,6 +258,32 @@ TEST(Determinism, SameSeedSameImageWithOneOrTwoThreads) {
   EXPECT_NE(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(Vec3)), 0);
 }
 
+// SessionStats::cpu_seconds sums the render threads' own CPU time: positive, and never more than
+// the threads could have run in the pass's wall time (a clock other than the threads' would break it).
+TEST(Stats, CpuSecondsCountEveryRenderThreadWithinTheWallTime) {
+  SceneDesc desc = parse_collada(sphere_scene(0.5f, 0, true), "furnace.dae");
+  RenderParams p;
+  p.file_camera = true;
+  p.width = p.height = 32;
+  p.adaptive = false;
+  p.max_depth = 8;
+  p.spp = 64;
+  for (int threads : {1, 2}) {
+    p.threads = threads;
+    p.tile_size = 8;  // 16 tiles: both threads get work
+    auto scene = make_render_scene(desc, p);
+    RenderSession s(*scene, p);
+    s.render_pass(16);
+    const SessionStats one = s.stats();
+    EXPECT_GT(one.cpu_seconds, 0) << threads;
+    EXPECT_LE(one.cpu_seconds, threads * one.seconds * 1.02 + 0.002) << threads;
+    s.render_pass(64);
+    const SessionStats two = s.stats();
+    EXPECT_GT(two.cpu_seconds, one.cpu_seconds) << "passes add up, threads " << threads;
+    EXPECT_LE(two.cpu_seconds, threads * two.seconds * 1.02 + 0.004) << threads;
+  }
+}
+
 TEST(Determinism, CellRenderEqualsThatWindowOfTheFullFrame) {
   PT_REQUIRE_SHARED_SCENE(path, "CBspheres.dae");
   SceneDesc desc = load_collada(path);
