@@ -61,11 +61,16 @@ void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, OIIO::Ty
   }
 }
 
-void write_exr(const ImageRGB& img, const std::string& path, const Metadata& meta) {
+// One EXR header for the file and the in-memory copy: linear float RGB, zip, our metadata.
+OIIO::ImageSpec exr_spec(const ImageRGB& img, const Metadata& meta) {
   OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
   spec.attribute("compression", "zip");
   for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
-  write_atomic(path, spec, OIIO::TypeDesc::FLOAT, img.pixels.data());
+  return spec;
+}
+
+void write_exr(const ImageRGB& img, const std::string& path, const Metadata& meta) {
+  write_atomic(path, exr_spec(img, meta), OIIO::TypeDesc::FLOAT, img.pixels.data());
 }
 
 void write_rgb8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path,
@@ -94,9 +99,7 @@ std::string encode_exr(const ImageRGB& img, const Metadata& meta) {
   OIIO::Filesystem::IOVecOutput vec(buffer);
   auto out = OIIO::ImageOutput::create("image.exr");
   if (!out) throw std::runtime_error("EXR encoder unavailable");
-  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
-  spec.attribute("compression", "zip");
-  for (const auto& kv : meta) spec.attribute(kv.first, kv.second);
+  OIIO::ImageSpec spec = exr_spec(img, meta);
   OIIO::Filesystem::IOProxy* proxy = &vec;
   spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
   if (!out->supports("ioproxy")) throw std::runtime_error("this OpenImageIO cannot write EXR to memory");
