@@ -5,6 +5,10 @@
 
 #include <embree3/rtcore.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -144,7 +148,8 @@ struct Accel::Impl {
   std::atomic<long long> embree_bytes{0};
   // The scene's bounds, padded; a ray that misses them skips Embree (most camera rays of the
   // course framing see only background). cull = false when the bounds are not finite.
-  float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  // A fourth lane (-inf, +inf) lets may_hit_bounds compare four floats at once.
+  float lo[4] = {0, 0, 0, -INFINITY}, hi[4] = {0, 0, 0, INFINITY};
   bool cull = false;
   // Rays a packet: 16 where Embree has 16-wide kernels (AVX-512), else 8. Without them Embree
   // takes a packet of 16 apart through its stream path, and native packets of 8 cost about 2% fewer
@@ -309,27 +314,54 @@ inline void to_embree(const Ray& r, RTCRay& e) {
 // they are treated as misses instead. Found by the scene fuzzer (tests/fuzz-regressions).
 inline bool embree_accepts(const Ray& r) {
   constexpr float kLarge = 1.844e18f;
+#if defined(__SSE2__)
+  // Both halves of the ray at once: |o.x o.y o.z d.x| and |d.y d.z tmin tmax| against the limit
+  // (infinity for tmin and tmax, which only have to be numbers). A NaN fails every compare.
+  static_assert(sizeof(Ray) == 8 * sizeof(float), "Ray is o, d, tmin, tmax without padding");
+  const float* f = reinterpret_cast<const float*>(&r);
+  const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  const __m128 lo = _mm_and_ps(_mm_loadu_ps(f), abs_mask), hi = _mm_and_ps(_mm_loadu_ps(f + 4), abs_mask);
+  const __m128 ok = _mm_and_ps(_mm_cmple_ps(lo, _mm_set1_ps(kLarge)),
+                               _mm_cmple_ps(hi, _mm_setr_ps(kLarge, kLarge, INFINITY, INFINITY)));
+  return _mm_movemask_ps(ok) == 0xF;
+#else
   return std::fabs(r.o.x) <= kLarge && std::fabs(r.o.y) <= kLarge && std::fabs(r.o.z) <= kLarge &&
          std::fabs(r.d.x) <= kLarge && std::fabs(r.d.y) <= kLarge && std::fabs(r.d.z) <= kLarge &&
          !std::isnan(r.tmin) && !std::isnan(r.tmax);
+#endif
 }
 
 // Slab test (Kay & Kajiya, "Ray tracing complex scenes", SIGGRAPH 1986) of the ray's segment
 // against the scene bounds. Rays that start inside the box (every bounce in a closed scene) pass at
 // once; the rest run the slabs unrolled and branch-free. A NaN from 0 * inf leaves the interval as
 // it was: never a false miss.
-inline bool may_hit_bounds(const Ray& r, const float lo[3], const float hi[3]) {
+// lo and hi hold four floats, the fourth -inf and +inf (Accel::Impl).
+inline bool may_hit_bounds(const Ray& r, const float lo[4], const float hi[4]) {
+  // max/min written so that a NaN operand yields the other one (the interval is left as it was);
+  // SSE's maxps and minps are these exact expressions.
+  auto mx = [](float a, float b) { return a > b ? a : b; };
+  auto mn = [](float a, float b) { return a < b ? a : b; };
+#if defined(__SSE2__)
+  const float* f = reinterpret_cast<const float*>(&r);
+  const __m128 o = _mm_loadu_ps(f), l = _mm_loadu_ps(lo), h = _mm_loadu_ps(hi);  // lane 3: d.x within (-inf, inf)
+  if (_mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(o, l), _mm_cmple_ps(o, h))) == 0xF) return true;
+  const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), _mm_loadu_ps(f + 3));  // 1/d (lane 3: 1/tmin, unused)
+  const __m128 a = _mm_mul_ps(_mm_sub_ps(l, o), inv), b = _mm_mul_ps(_mm_sub_ps(h, o), inv);
+  alignas(16) float near[4], far[4];
+  _mm_store_ps(near, _mm_min_ps(a, b));
+  _mm_store_ps(far, _mm_max_ps(a, b));
+  const float t0 = mx(mx(mx(r.tmin, near[0]), near[1]), near[2]);
+  const float t1 = mn(mn(mn(r.tmax, far[0]), far[1]), far[2]);
+#else
   if (r.o.x >= lo[0] && r.o.x <= hi[0] && r.o.y >= lo[1] && r.o.y <= hi[1] && r.o.z >= lo[2] && r.o.z <= hi[2])
     return true;
   const float ix = 1.0f / r.d.x, iy = 1.0f / r.d.y, iz = 1.0f / r.d.z;
   const float ax = (lo[0] - r.o.x) * ix, bx = (hi[0] - r.o.x) * ix;
   const float ay = (lo[1] - r.o.y) * iy, by = (hi[1] - r.o.y) * iy;
   const float az = (lo[2] - r.o.z) * iz, bz = (hi[2] - r.o.z) * iz;
-  // max/min written so that a NaN operand yields the other one (the interval is left as it was).
-  auto mx = [](float a, float b) { return a > b ? a : b; };
-  auto mn = [](float a, float b) { return a < b ? a : b; };
-  float t0 = mx(mx(mx(r.tmin, mn(ax, bx)), mn(ay, by)), mn(az, bz));
-  float t1 = mn(mn(mn(r.tmax, mx(ax, bx)), mx(ay, by)), mx(az, bz));
+  const float t0 = mx(mx(mx(r.tmin, mn(ax, bx)), mn(ay, by)), mn(az, bz));
+  const float t1 = mn(mn(mn(r.tmax, mx(ax, bx)), mx(ay, by)), mx(az, bz));
+#endif
   return !(t0 > t1);
 }
 
@@ -412,8 +444,13 @@ template <class RayK>
 inline void to_lane(const Ray& r, RayK& e, int k) {
   e.org_x[k] = r.o.x, e.org_y[k] = r.o.y, e.org_z[k] = r.o.z;
   e.dir_x[k] = r.d.x, e.dir_y[k] = r.d.y, e.dir_z[k] = r.d.z;
-  e.tnear[k] = r.tmin, e.tfar[k] = r.tmax, e.time[k] = 0;
-  e.mask[k] = 0xFFFFFFFFu, e.id[k] = 0, e.flags[k] = 0;
+  e.tnear[k] = r.tmin, e.tfar[k] = r.tmax;
+}
+
+// The fields every lane shares and Embree only reads: set once per packet, not per ray.
+template <int K, class RayK>
+inline void set_constant_lanes(RayK& e) {
+  for (int k = 0; k < K; ++k) e.time[k] = 0, e.mask[k] = 0xFFFFFFFFu, e.id[k] = 0, e.flags[k] = 0;
 }
 
 // The caller's rays, `stride` bytes apart.
@@ -499,6 +536,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   alignas(64) typename Packet<K>::RayHit rh;
+  set_constant_lanes<K>(rh.ray);
   Lanes<K> lanes;
   const StridedRays at{reinterpret_cast<const char*>(rays), stride};
   auto trace = [&] {
@@ -529,6 +567,7 @@ void occluded_packets(const Accel::Impl& a, const Ray* rays, size_t n, uint8_t* 
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   alignas(64) typename Packet<K>::Ray rk;
+  set_constant_lanes<K>(rk);
   Lanes<K> lanes;
   auto trace = [&] {
     lanes.seal(rays, rk);
@@ -566,6 +605,8 @@ template <int K>
 size_t cast_packets(RTCScene scene, RTCIntersectContext& ctx, const Ray* rays, const uint8_t* shadow, size_t n) {
   alignas(64) typename Packet<K>::RayHit hitsK;
   alignas(64) typename Packet<K>::Ray shadowsK;
+  set_constant_lanes<K>(hitsK.ray);
+  set_constant_lanes<K>(shadowsK);
   size_t hits = 0;
   for (int kind = 0; kind < 2; ++kind) {
     typename Packet<K>::Ray& rk = kind ? shadowsK : hitsK.ray;

@@ -225,6 +225,52 @@ TEST(Accel, ManyAtOnceAgreesWithOneAtATimeAtEitherPacketWidth) {
   }
 }
 
+// Embree answers only rays whose origin and direction components lie within +-1.844e18 and whose
+// fields are numbers. Accel refuses the rest (no hit, no occlusion) in every call, and traces the
+// others, however large within the limit or with an unbounded segment.
+TEST(Accel, RaysOutsideEmbreesRangeAreRefusedTheRestTraced) {
+  SceneDesc d = two_shapes(Vec3(0, 0, 0));
+  Accel accel(d, {}, {});
+  Ray aimed;  // from in front of the quad, straight at it: a hit when traced
+  aimed.o = Vec3(0.1f, 0.1f, 3);
+  aimed.d = Vec3(0, 0, -1);
+  aimed.tmin = 0;
+  aimed.tmax = kInf;
+  std::vector<Ray> refused;
+  for (int field = 0; field < 8; ++field) {  // a NaN in any field
+    Ray r = aimed;
+    float* f[8] = {&r.o.x, &r.o.y, &r.o.z, &r.d.x, &r.d.y, &r.d.z, &r.tmin, &r.tmax};
+    *f[field] = NAN;
+    refused.push_back(r);
+  }
+  // Still aimed at the quad, past the limit: a direction of 2e18, an origin 2e18 away.
+  Ray long_dir = aimed, far_origin = aimed;
+  long_dir.d = Vec3(0, 0, -2e18f);
+  far_origin.o = Vec3(0.1f, 0.1f, 2e18f);
+  refused.push_back(long_dir);
+  refused.push_back(far_origin);
+  Ray big = aimed;  // the largest direction Embree takes: still a hit
+  big.d = Vec3(0, 0, -1.8e18f);
+  std::vector<Ray> traced = {aimed, big};
+  for (int width : {8, 16}) {
+    accel.set_packet_width(width);
+    std::vector<Ray> all = refused;
+    all.insert(all.end(), traced.begin(), traced.end());
+    std::vector<SurfaceHit> hits(all.size());
+    std::vector<uint8_t> found(all.size(), 7), blocked(all.size(), 7);
+    accel.intersect_many(all.data(), all.size(), hits.data(), found.data());
+    accel.occluded_many(all.data(), all.size(), blocked.data());
+    for (size_t i = 0; i < all.size(); ++i) {
+      SurfaceHit h;
+      const bool want = i >= refused.size();
+      EXPECT_EQ(accel.intersect(all[i], h), want) << "ray " << i;
+      EXPECT_EQ(accel.occluded(all[i]), want) << "ray " << i;
+      EXPECT_EQ(found[i], want ? 1 : 0) << "ray " << i << ", packets of " << width;
+      EXPECT_EQ(blocked[i], want ? 1 : 0) << "ray " << i << ", packets of " << width;
+    }
+  }
+}
+
 namespace {
 
 // A ray against a box, in double precision (independent of Accel's float slab test).
