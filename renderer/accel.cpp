@@ -105,33 +105,98 @@ inline bool sphere_hit(const float* s, RTCRayN* ray, unsigned N, unsigned i, flo
   return t > tnear && t < RTCRayN_tfar(ray, N, i);
 }
 
+#if defined(__SSE2__)
+// sphere_hit for four lanes of a packet at once (lanes i..i+3, contiguous in Embree's SoA layout):
+// the same operations in the same order, so the same bits; returns the mask of valid lanes with a
+// root in (tnear, tfar), and their t.
+inline int sphere_hit4(const float* s, RTCRayN* ray, unsigned N, unsigned i, const int* valid, __m128& t) {
+  const __m128 valid4 = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(valid + i)),
+                                                         _mm_set1_epi32(-1)));
+  if (_mm_movemask_ps(valid4) == 0) return 0;
+  const __m128 dx = _mm_loadu_ps(&RTCRayN_dir_x(ray, N, i)), dy = _mm_loadu_ps(&RTCRayN_dir_y(ray, N, i)),
+               dz = _mm_loadu_ps(&RTCRayN_dir_z(ray, N, i));
+  const __m128 fx = _mm_sub_ps(_mm_loadu_ps(&RTCRayN_org_x(ray, N, i)), _mm_set1_ps(s[0]));
+  const __m128 fy = _mm_sub_ps(_mm_loadu_ps(&RTCRayN_org_y(ray, N, i)), _mm_set1_ps(s[1]));
+  const __m128 fz = _mm_sub_ps(_mm_loadu_ps(&RTCRayN_org_z(ray, N, i)), _mm_set1_ps(s[2]));
+  const __m128 r = _mm_set1_ps(s[3]), rr = _mm_mul_ps(r, r), zero = _mm_setzero_ps();
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  auto dot = [](__m128 ax, __m128 ay, __m128 az, __m128 bx, __m128 by, __m128 bz) {
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz));
+  };
+  const __m128 a = dot(dx, dy, dz, dx, dy, dz);
+  const __m128 b = _mm_xor_ps(dot(fx, fy, fz, dx, dy, dz), sign);
+  const __m128 k = _mm_div_ps(b, a);
+  const __m128 lx = _mm_add_ps(fx, _mm_mul_ps(k, dx)), ly = _mm_add_ps(fy, _mm_mul_ps(k, dy)),
+               lz = _mm_add_ps(fz, _mm_mul_ps(k, dz));
+  const __m128 disc = _mm_mul_ps(a, _mm_sub_ps(rr, dot(lx, ly, lz, lx, ly, lz)));
+  __m128 ok = _mm_and_ps(valid4, _mm_and_ps(_mm_cmpge_ps(disc, zero), _mm_cmpgt_ps(a, zero)));
+  if (_mm_movemask_ps(ok) == 0) return 0;
+  const __m128 c = _mm_sub_ps(dot(fx, fy, fz, fx, fy, fz), rr);
+  const __m128 q = _mm_add_ps(b, _mm_or_ps(_mm_sqrt_ps(disc), _mm_and_ps(b, sign)));  // b + copysign(sqrt, b)
+  const __m128 t0q = _mm_and_ps(_mm_div_ps(c, q), _mm_cmpneq_ps(q, zero));         // q != 0 ? c / q : 0
+  const __m128 t1q = _mm_div_ps(q, a);
+  const __m128 t0 = _mm_min_ps(t1q, t0q), t1 = _mm_max_ps(t0q, t1q);  // if (t0 > t1) swap
+  const __m128 tnear = _mm_loadu_ps(&RTCRayN_tnear(ray, N, i)), tfar = _mm_loadu_ps(&RTCRayN_tfar(ray, N, i));
+  const __m128 first = _mm_cmpgt_ps(t0, tnear);
+  t = _mm_or_ps(_mm_and_ps(first, t0), _mm_andnot_ps(first, t1));  // t0 > tnear ? t0 : t1
+  ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(t, tnear), _mm_cmplt_ps(t, tfar)));
+  return _mm_movemask_ps(ok);
+}
+#endif
+
+// A hit of ray i at t: Embree's hit record, the normal unnormalised (refine_hit normalises it).
+inline void sphere_record(const RTCIntersectFunctionNArguments* args, const float* s, unsigned i, float t) {
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
+  RTCRayN_tfar(ray, args->N, i) = t;
+  float px = RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i);
+  float py = RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i);
+  float pz = RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i);
+  RTCHitN_Ng_x(hit, args->N, i) = px - s[0];
+  RTCHitN_Ng_y(hit, args->N, i) = py - s[1];
+  RTCHitN_Ng_z(hit, args->N, i) = pz - s[2];
+  RTCHitN_u(hit, args->N, i) = 0;
+  RTCHitN_v(hit, args->N, i) = 0;
+  RTCHitN_primID(hit, args->N, i) = args->primID;
+  RTCHitN_geomID(hit, args->N, i) = args->geomID;
+  RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+}
+
 void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
   const float* s = static_cast<const float*>(args->geometryUserPtr) + 4 * args->primID;
-  RTCRayHitN* rh = args->rayhit;
-  RTCRayN* ray = RTCRayHitN_RayN(rh, args->N);
-  RTCHitN* hit = RTCRayHitN_HitN(rh, args->N);
-  for (unsigned i = 0; i < args->N; ++i) {
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
+  unsigned i = 0;
+#if defined(__SSE2__)
+  for (; args->N % 4 == 0 && i < args->N; i += 4) {  // packets: four rays at a time
+    __m128 t;
+    alignas(16) float ts[4];
+    int hits = sphere_hit4(s, ray, args->N, i, args->valid, t);
+    if (!hits) continue;
+    _mm_store_ps(ts, t);
+    for (; hits; hits &= hits - 1) {
+      const int k = __builtin_ctz(unsigned(hits));
+      sphere_record(args, s, i + unsigned(k), ts[k]);
+    }
+  }
+#endif
+  for (; i < args->N; ++i) {
     float t;
-    if (args->valid[i] != -1 || !sphere_hit(s, ray, args->N, i, t)) continue;
-    RTCRayN_tfar(ray, args->N, i) = t;
-    float px = RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i);
-    float py = RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i);
-    float pz = RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i);
-    RTCHitN_Ng_x(hit, args->N, i) = px - s[0];
-    RTCHitN_Ng_y(hit, args->N, i) = py - s[1];
-    RTCHitN_Ng_z(hit, args->N, i) = pz - s[2];
-    RTCHitN_u(hit, args->N, i) = 0;
-    RTCHitN_v(hit, args->N, i) = 0;
-    RTCHitN_primID(hit, args->N, i) = args->primID;
-    RTCHitN_geomID(hit, args->N, i) = args->geomID;
-    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+    if (args->valid[i] == -1 && sphere_hit(s, ray, args->N, i, t)) sphere_record(args, s, i, t);
   }
 }
 
 void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   const float* s = static_cast<const float*>(args->geometryUserPtr) + 4 * args->primID;
   RTCRayN* ray = args->ray;
-  for (unsigned i = 0; i < args->N; ++i) {
+  unsigned i = 0;
+#if defined(__SSE2__)
+  for (; args->N % 4 == 0 && i < args->N; i += 4) {
+    __m128 t;
+    for (int hits = sphere_hit4(s, ray, args->N, i, args->valid, t); hits; hits &= hits - 1)
+      RTCRayN_tfar(ray, args->N, i + unsigned(__builtin_ctz(unsigned(hits)))) = -INFINITY;
+  }
+#endif
+  for (; i < args->N; ++i) {
     float t;
     if (args->valid[i] == -1 && sphere_hit(s, ray, args->N, i, t)) RTCRayN_tfar(ray, args->N, i) = -INFINITY;
   }
