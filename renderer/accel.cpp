@@ -80,7 +80,7 @@ inline bool sphere_hit(const float* s, RTCRayN* ray, unsigned N, unsigned i, flo
 inline RayLanes4 lanes4(RTCRayN* ray, unsigned N, unsigned i, const int* valid) {
   return {&RTCRayN_org_x(ray, N, i), &RTCRayN_org_y(ray, N, i), &RTCRayN_org_z(ray, N, i),
           &RTCRayN_dir_x(ray, N, i), &RTCRayN_dir_y(ray, N, i), &RTCRayN_dir_z(ray, N, i),
-          &RTCRayN_tnear(ray, N, i), &RTCRayN_tfar(ray, N, i),  valid + i};
+          &RTCRayN_tnear(ray, N, i), &RTCRayN_tfar(ray, N, i), valid + i};
 }
 
 // A hit of ray i at t: Embree's hit record, the normal unnormalised (refine_hit normalises it).
