@@ -164,12 +164,14 @@ int main(int argc, char** argv) {
       // Each run's PT over the replay right after it, then the median: pairs cancel the machine's
       // slow drift, which a ratio of two medians taken over the whole run does not.
       const std::vector<double>& own = p.ray_packets ? acc_many : acc;
-      std::vector<double> paired, paired_raw;
-      for (size_t r = 0; r < pt_rate.size(); ++r) paired.push_back(pt_rate[r] / own[r]);
       // Against Embree alone, called the way the path tracer calls it (packets of Accel's width, or
-      // single rays): our wrapper's checks and hit refinement count as the path tracer's time here.
+      // single rays): our wrapper's checks and hit refinement count as the path tracer's time there.
       const std::vector<double>& raw_own = !p.ray_packets ? raw : packet_width == 16 ? packet : packet8;
-      for (size_t r = 0; r < pt_rate.size(); ++r) paired_raw.push_back(pt_rate[r] / raw_own[r]);
+      std::vector<double> paired, paired_raw;
+      for (size_t r = 0; r < pt_rate.size(); ++r) {
+        paired.push_back(pt_rate[r] / own[r]);
+        paired_raw.push_back(pt_rate[r] / raw_own[r]);
+      }
       // The spread of the paired ratios: on a noisy host the median alone hides how close it is.
       const auto [lo, hi] = std::minmax_element(paired.begin(), paired.end());
       char line[512];

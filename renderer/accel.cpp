@@ -70,8 +70,8 @@ void sphere_bounds(const RTCBoundsFunctionArguments* args) {
 }
 
 // Ray i of a ray packet against sphere s (accel_math.h).
-inline bool sphere_hit(const float* s, RTCRayN* ray, unsigned N, unsigned i, float& t) {
-  return pt::sphere_hit(s, RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i),
+inline bool sphere_hit_lane(const float* s, RTCRayN* ray, unsigned N, unsigned i, float& t) {
+  return sphere_hit(s, RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i),
                         RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i),
                         RTCRayN_tnear(ray, N, i), RTCRayN_tfar(ray, N, i), t);
 }
@@ -114,7 +114,7 @@ void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
   }
   for (; i < args->N; ++i) {
     float t;
-    if (args->valid[i] == -1 && sphere_hit(s, ray, args->N, i, t)) sphere_record(args, s, i, t);
+    if (args->valid[i] == -1 && sphere_hit_lane(s, ray, args->N, i, t)) sphere_record(args, s, i, t);
   }
 }
 
@@ -129,7 +129,7 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   }
   for (; i < args->N; ++i) {
     float t;
-    if (args->valid[i] == -1 && sphere_hit(s, ray, args->N, i, t)) RTCRayN_tfar(ray, args->N, i) = -INFINITY;
+    if (args->valid[i] == -1 && sphere_hit_lane(s, ray, args->N, i, t)) RTCRayN_tfar(ray, args->N, i) = -INFINITY;
   }
 }
 
