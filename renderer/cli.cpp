@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
@@ -27,7 +28,11 @@ float parse_float(const std::string& flag, const std::string& s, double lo, doub
   double v = std::strtod(s.c_str(), &end);
   if (s.empty() || *end != '\0') throw UsageError(flag + ": '" + s + "' is not a number");
   if (!std::isfinite(v)) throw UsageError(flag + ": '" + s + "' is not finite");
-  if (v < lo || v > hi) throw UsageError(flag + ": " + s + " is out of range");
+  if (v < lo || v > hi) {
+    char range[64];
+    std::snprintf(range, sizeof range, " is out of range [%g, %g]", lo, hi);
+    throw UsageError(flag + ": " + s + range);
+  }
   return float(v);
 }
 

@@ -120,6 +120,7 @@ TEST(Cli, BadFlagsAreNamed) {
       {"-b -1 s.dae", "-b"},          {"-x s.dae", "-x"},            {"-p 0 0 900 10 s.dae", "cell"},
       {"-f", "-f"},                   {"", "scene"},                 {"a.dae b.dae", "more than one"},
       {"-a 0 0.05 s.dae", "-a"},      {"-t 0 s.dae", "-t"},          {"-l 99999999999 s.dae", "-l"},
+      {"-b 2e6 s.dae", "-b: 2e6 is out of range [0, 1e+06]"},  // a number out of range shows the range
   };
   for (const Case& c : cases) {
     try {
