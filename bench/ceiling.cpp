@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   std::printf("bench_ceiling: rays of one %d-spp pass at %s (keep_fov, m = 5, light_samples 1, no adaptive), "
               "%s sampler, replayed; rays/s are medians of %d runs\n",
               spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);
-  std::vector<std::string> table;
+  std::vector<std::string> table, split;
   int packet_width = 0;  // Accel's, the same for every scene (Embree's native width)
   ProgressBar bar("bench_ceiling");
   int done = 0;
@@ -140,25 +140,52 @@ int main(int argc, char** argv) {
       replay_rate(accel, rec, 1, m, batch);  // warm up
     for (int threads : {1, 2}) {
       std::vector<double> pt_rate, acc, acc_many, raw, stream, packet, packet8;
+      // One thread renders and replays on this thread, where AccelTimer sees every Embree call.
+      const bool timed = threads == 1;
+      AccelTimer pt_timer, raw_timer;
+      uint64_t pt_ticks = 0, raw_ticks = 0;
+      const Mode raw_mode = !p.ray_packets ? Mode::raw : packet_width == 16 ? Mode::packet16 : Mode::packet8;
       for (int r = 0; r < runs; ++r) {  // interleaved, so drift hits every column alike
         RenderParams pt = p;
         pt.threads = threads;
         RenderSession s(*scene, pt);
+        if (timed) time_accel_on_this_thread(&pt_timer);
+        const uint64_t t0 = accel_ticks();
         s.render_pass(spp);
+        if (timed) pt_ticks += accel_ticks() - t0;
+        time_accel_on_this_thread(nullptr);
         pt_rate.push_back(double(rec.rays.size()) / s.stats().seconds);
         bar.update(double(++done) / total);
         acc_many.push_back(replay_rate(accel, rec, threads, Mode::accel_many, batch));
         bar.update(double(++done) / total);
         acc.push_back(replay_rate(accel, rec, threads, Mode::accel, batch));
         bar.update(double(++done) / total);
-        raw.push_back(replay_rate(accel, rec, threads, Mode::raw, batch));
-        bar.update(double(++done) / total);
-        stream.push_back(replay_rate(accel, rec, threads, Mode::stream, batch));
-        bar.update(double(++done) / total);
-        packet.push_back(replay_rate(accel, rec, threads, Mode::packet16, batch));
-        bar.update(double(++done) / total);
-        packet8.push_back(replay_rate(accel, rec, threads, Mode::packet8, batch));
-        bar.update(double(++done) / total);
+        // The replay the path tracer is held against (PT/raw), timed like the path tracer's pass.
+        auto replay_timed = [&](Mode m) {
+          const bool timing = timed && m == raw_mode;
+          if (timing) time_accel_on_this_thread(&raw_timer);
+          const uint64_t t0 = accel_ticks();
+          const double rate = replay_rate(accel, rec, threads, m, batch);
+          if (timing) raw_ticks += accel_ticks() - t0;
+          time_accel_on_this_thread(nullptr);
+          bar.update(double(++done) / total);
+          return rate;
+        };
+        raw.push_back(replay_timed(Mode::raw));
+        stream.push_back(replay_timed(Mode::stream));
+        packet.push_back(replay_timed(Mode::packet16));
+        packet8.push_back(replay_timed(Mode::packet8));
+      }
+      if (timed) {
+        // PT/raw is (Embree's share of PT's time) / (its share of the replay's) when the calls
+        // themselves take as long in both: "Embree PT/raw" says how far that holds.
+        char line[256];
+        std::snprintf(line, sizeof line, "%-10s %9.1f%% %9.1f%% %9.1f%% %11.1f%% %13.2f %9.1f", sc.name.c_str(),
+                      100.0 * pt_timer.embree / pt_ticks, 100.0 * pt_timer.refine / pt_ticks,
+                      100.0 * (pt_ticks - pt_timer.embree - pt_timer.refine) / pt_ticks, 100.0 * raw_timer.embree / raw_ticks,
+                      double(pt_timer.embree) / double(raw_timer.embree),
+                      double(pt_ticks - pt_timer.embree - pt_timer.refine) / double(runs) / double(rec.rays.size()));
+        split.push_back(line);
       }
       // The path tracer casts packets unless told not to; its ceiling is the replay the same way.
       // Each run's PT over the replay right after it, then the median: pairs cancel the machine's
@@ -195,5 +222,18 @@ int main(int argc, char** argv) {
               "rtcIntersect1M / rtcOccluded1M, %zu rays a call; packet16 / packet8 = rtcIntersect16 / rtcOccluded16 and "
               "rtcIntersect8 / rtcOccluded8\n",
               RenderParams().ray_packets ? "in Embree packets" : "one ray at a time", packet_width, packet_width, batch);
+  std::printf("\nWhere the time goes, one thread (AccelTimer, summed over the runs):\n%-10s %10s %10s %10s %12s %13s %9s\n",
+              "scene", "PT Embree", "PT refine", "PT rest", "raw Embree", "Embree PT/raw", "rest/ray");
+  for (const std::string& l : split) std::printf("%s\n", l.c_str());
+  std::printf("PT Embree / refine / rest = shares of the path tracer's pass: the Embree calls, the hit refinement after "
+              "packet intersections (Accel), everything else (sampling, shading, film, our checks around Embree); raw "
+              "Embree = Embree's share of the replay PT/raw compares with (the rest packs the packets); Embree PT/raw = "
+              "the Embree calls' time in the pass over their time in that replay (1: the same rays cost the same inside "
+              "the path tracer); rest/ray = the path tracer's own time a ray, in %s\n",
+#if defined(__x86_64__) || defined(__i386__)
+              "time-stamp-counter ticks");
+#else
+              "nanoseconds");
+#endif
   return 0;
 }

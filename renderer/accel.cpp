@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -15,6 +16,10 @@
 #include <vector>
 
 #include "accel_math.h"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <x86intrin.h>
+#endif
 
 namespace pt {
 
@@ -316,6 +321,39 @@ thread_local RayRecorder* t_recorder = nullptr;  // benchmarks only: see record_
 
 void record_rays_on_this_thread(RayRecorder* r) { t_recorder = r; }
 
+uint64_t accel_ticks() {
+#if defined(__x86_64__) || defined(__i386__)
+  return __rdtsc();
+#else
+  return uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
+#endif
+}
+
+namespace {
+
+thread_local AccelTimer* t_timer = nullptr;  // benchmarks only: see time_accel_on_this_thread
+
+// Adds the time from its construction to the end of its scope to one field of the thread's
+// timer, where one is set.
+class TimeInto {
+ public:
+  explicit TimeInto(uint64_t AccelTimer::*field)
+      : m_into(__builtin_expect(t_timer != nullptr, 0) ? &(t_timer->*field) : nullptr), m_t0(m_into ? accel_ticks() : 0) {}
+  ~TimeInto() {
+    if (__builtin_expect(m_into != nullptr, 0)) *m_into += accel_ticks() - m_t0;
+  }
+  TimeInto(const TimeInto&) = delete;
+  TimeInto& operator=(const TimeInto&) = delete;
+
+ private:
+  uint64_t* m_into;
+  uint64_t m_t0;
+};
+
+}  // namespace
+
+void time_accel_on_this_thread(AccelTimer* t) { t_timer = t; }
+
 namespace {
 
 // The hit record from Embree's answer: the point refined from the barycentrics or the sphere
@@ -367,15 +405,27 @@ template <>
 struct Packet<8> {
   using RayHit = RTCRayHit8;
   using Ray = RTCRay8;
-  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect8(valid, s, c, r); }
-  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded8(valid, s, c, r); }
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) {
+    TimeInto timed(&AccelTimer::embree);
+    rtcIntersect8(valid, s, c, r);
+  }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) {
+    TimeInto timed(&AccelTimer::embree);
+    rtcOccluded8(valid, s, c, r);
+  }
 };
 template <>
 struct Packet<16> {
   using RayHit = RTCRayHit16;
   using Ray = RTCRay16;
-  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect16(valid, s, c, r); }
-  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(valid, s, c, r); }
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) {
+    TimeInto timed(&AccelTimer::embree);
+    rtcIntersect16(valid, s, c, r);
+  }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) {
+    TimeInto timed(&AccelTimer::embree);
+    rtcOccluded16(valid, s, c, r);
+  }
 };
 
 // One packet lane from a ray.
@@ -435,8 +485,12 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   to_embree(ray, rh.ray);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(m_impl->scene, &ctx, &rh);
+  {
+    TimeInto timed(&AccelTimer::embree);
+    rtcIntersect1(m_impl->scene, &ctx, &rh);
+  }
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  TimeInto timed(&AccelTimer::refine);
   refine_hit(a.geoms[rh.hit.geomID], ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v,
              Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), hit);
   return true;
@@ -481,6 +535,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
   auto trace = [&] {
     lanes.seal(at, rh.ray);
     Packet<K>::intersect(lanes.valid, a.scene, &ctx, &rh);
+    TimeInto timed(&AccelTimer::refine);
     for (int k = 0; k < lanes.used; ++k) {
       const uint32_t i = lanes.ray[k];
       if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
@@ -533,7 +588,10 @@ bool Accel::occluded(const Ray& ray) const {
   rtcInitIntersectContext(&ctx);
   RTCRay r;
   to_embree(ray, r);
-  rtcOccluded1(m_impl->scene, &ctx, &r);
+  {
+    TimeInto timed(&AccelTimer::embree);
+    rtcOccluded1(m_impl->scene, &ctx, &r);
+  }
   return r.tfar < 0;  // Embree sets tfar = -inf on a hit
 }
 
@@ -585,14 +643,20 @@ size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode
       if (shadow[i]) {
         RTCRay r;
         to_embree(rays[i], r);
-        rtcOccluded1(scene, &ctx, &r);
+        {
+          TimeInto timed(&AccelTimer::embree);
+          rtcOccluded1(scene, &ctx, &r);
+        }
         hits += r.tfar < 0;
       } else {
         RTCRayHit rh;
         to_embree(rays[i], rh.ray);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(scene, &ctx, &rh);
+        {
+          TimeInto timed(&AccelTimer::embree);
+          rtcIntersect1(scene, &ctx, &rh);
+        }
         hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
       }
     }
@@ -602,12 +666,18 @@ size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode
   std::vector<RTCRay> shadow_rays(batch);
   size_t nh = 0, ns = 0;
   auto flush_hits = [&] {
-    rtcIntersect1M(scene, &ctx, hit_rays.data(), unsigned(nh), sizeof(RTCRayHit));
+    {
+      TimeInto timed(&AccelTimer::embree);
+      rtcIntersect1M(scene, &ctx, hit_rays.data(), unsigned(nh), sizeof(RTCRayHit));
+    }
     for (size_t k = 0; k < nh; ++k) hits += hit_rays[k].hit.geomID != RTC_INVALID_GEOMETRY_ID;
     nh = 0;
   };
   auto flush_shadows = [&] {
-    rtcOccluded1M(scene, &ctx, shadow_rays.data(), unsigned(ns), sizeof(RTCRay));
+    {
+      TimeInto timed(&AccelTimer::embree);
+      rtcOccluded1M(scene, &ctx, shadow_rays.data(), unsigned(ns), sizeof(RTCRay));
+    }
     for (size_t k = 0; k < ns; ++k) hits += shadow_rays[k].tfar < 0;
     ns = 0;
   };

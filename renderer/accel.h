@@ -91,6 +91,20 @@ struct RayRecorder {
 // default) it costs one thread-local pointer test per query.
 void record_rays_on_this_thread(RayRecorder* r);
 
+// Benchmarks only: where a thread's time goes around Embree, in ticks of accel_ticks()'s clock.
+// `embree` sums the Embree calls themselves (every intersect and occluded query, raw replays
+// included); `refine` sums the hit refinement after packet intersections (refine_hit: the hit
+// point, normals, material). bench_ceiling splits the path tracer's time with them.
+struct AccelTimer {
+  uint64_t embree = 0, refine = 0;
+};
+// Starts (or with nullptr stops) timing the calling thread's queries into `t`. Unset (the
+// default) it costs one thread-local pointer test per Embree call.
+void time_accel_on_this_thread(AccelTimer* t);
+// The clock AccelTimer counts in: the CPU's time-stamp counter on x86 (a few cycles a read),
+// steady_clock nanoseconds elsewhere. Only differences of it mean anything.
+uint64_t accel_ticks();
+
 // Offsets follow Waechter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
 // Ray Tracing Gems ch. 6 (2019), so they scale with the hit's coordinates: an integer ULP offset
 // away from the surface, a float offset near the origin. Inline: every bounce and shadow ray

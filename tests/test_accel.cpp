@@ -7,6 +7,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "accel.h"
 #include "collada.h"
@@ -269,6 +270,56 @@ TEST(Accel, RaysOutsideEmbreesRangeAreRefusedTheRestTraced) {
       EXPECT_EQ(blocked[i], want ? 1 : 0) << "ray " << i << ", packets of " << width;
     }
   }
+}
+
+// AccelTimer (bench_ceiling's split of the path tracer's time): only the thread it is set on,
+// only while set; Embree time for every kind of query, refinement time for packet hits.
+TEST(Accel, TimerCountsTheCallingThreadsQueriesWhileSet) {
+  SceneDesc d = two_shapes(Vec3(0, 0, 0));
+  Accel accel(d, {}, {});
+  Ray aimed;
+  aimed.o = Vec3(0.1f, 0.1f, 3);
+  aimed.d = Vec3(0, 0, -1);
+  aimed.tmin = 0;
+  aimed.tmax = kInf;
+  std::vector<Ray> rays(64, aimed);
+  std::vector<SurfaceHit> hits(rays.size());
+  std::vector<uint8_t> found(rays.size()), blocked(rays.size());
+  AccelTimer timer;
+  accel.intersect_many(rays.data(), rays.size(), hits.data(), found.data());  // not set yet: not counted
+  EXPECT_EQ(timer.embree, 0u);
+  EXPECT_EQ(timer.refine, 0u);
+
+  time_accel_on_this_thread(&timer);
+  const uint64_t t0 = accel_ticks();
+  accel.intersect_many(rays.data(), rays.size(), hits.data(), found.data());
+  const uint64_t after_packets = timer.embree, refined = timer.refine;
+  EXPECT_GT(after_packets, 0u);
+  EXPECT_GT(refined, 0u);  // every ray hit the quad
+  accel.occluded_many(rays.data(), rays.size(), blocked.data());
+  EXPECT_GT(timer.embree, after_packets);
+  uint64_t before = timer.embree;
+  SurfaceHit h;
+  EXPECT_TRUE(accel.intersect(aimed, h));
+  EXPECT_TRUE(accel.occluded(aimed));
+  EXPECT_GT(timer.embree, before);
+  EXPECT_GT(timer.refine, refined);  // the single hit's refinement
+  before = timer.embree;
+  const uint64_t refined_all = timer.refine;
+  std::vector<uint8_t> shadow(rays.size(), 0);
+  EXPECT_EQ(accel.cast_raw(rays.data(), shadow.data(), rays.size(), Accel::RawMode::packet8, 8), rays.size());
+  EXPECT_GT(timer.embree, before);
+  EXPECT_EQ(timer.refine, refined_all);  // raw casts refine nothing
+  const uint64_t elapsed = accel_ticks() - t0;
+  EXPECT_LE(timer.embree + timer.refine, elapsed);  // parts of the time between the two reads
+
+  // Another thread's queries are its own; and once unset, nothing is added.
+  const AccelTimer seen = timer;
+  std::thread([&] { accel.intersect_many(rays.data(), rays.size(), hits.data(), found.data()); }).join();
+  time_accel_on_this_thread(nullptr);
+  accel.intersect_many(rays.data(), rays.size(), hits.data(), found.data());
+  EXPECT_EQ(timer.embree, seen.embree);
+  EXPECT_EQ(timer.refine, seen.refine);
 }
 
 namespace {

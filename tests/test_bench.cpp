@@ -65,6 +65,20 @@ TEST(BenchSmoke, Ceiling) {
   for (std::sregex_iterator m(out.begin(), out.end(), raw_ratio), end; m != end; ++m, ++rows)
     EXPECT_GT(std::stod((*m)[1]), 0) << m->str();
   EXPECT_EQ(rows, 2) << out;
+  // The split of the one-thread pass: three shares that add up to the whole, Embree's share of
+  // the raw replay, the Embree calls' time in the pass over the replay's, the rest a ray.
+  std::smatch m;
+  std::regex split(R"(\ndof +(\d+\.\d)% +(\d+\.\d)% +(-?\d+\.\d)% +(\d+\.\d)% +(\d+\.\d\d) +(\d+\.\d)\n)");
+  ASSERT_TRUE(std::regex_search(out, m, split)) << out;
+  const double embree = std::stod(m[1]), refine = std::stod(m[2]), rest = std::stod(m[3]);
+  EXPECT_GT(embree, 0) << m.str();
+  EXPECT_GT(refine, 0) << m.str();
+  EXPECT_GT(rest, 0) << m.str();
+  EXPECT_NEAR(embree + refine + rest, 100.0, 0.2) << m.str();
+  EXPECT_GT(std::stod(m[4]), 0) << m.str();
+  EXPECT_LE(std::stod(m[4]), 100.0) << m.str();
+  EXPECT_GT(std::stod(m[5]), 0) << m.str();
+  EXPECT_GT(std::stod(m[6]), 0) << m.str();
 }
 
 TEST(BenchSmoke, Scaling) {
