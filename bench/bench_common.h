@@ -29,7 +29,8 @@ inline bool exists(const std::string& p) {
 
 // CBspheres (m = 100), CBbunny, CBdragon (m = 5) from ../shared/scenes-cs184 and our dof.dae
 // (thin lens 0.12, focus 4.7, m = 5). Prints one skip line when the course scenes are absent.
-// `only`: keep the scenes whose name contains it (empty: all). Smoke mode: dof.dae only.
+// `only`: keep the scenes whose name contains it (empty: all; none matching exits 2). Smoke mode:
+// dof.dae only.
 inline std::vector<BenchScene> bench_scenes(const char* prog, bool smoke, const std::string& only) {
   std::vector<BenchScene> out;
   const std::string own = std::string(PT_SOURCE_DIR) + "/scenes/";
@@ -44,11 +45,18 @@ inline std::vector<BenchScene> bench_scenes(const char* prog, bool smoke, const 
     std::printf("%s: skipping CBspheres, CBbunny, CBdragon: ../shared/scenes-cs184 is absent\n", prog);
   }
   out.push_back(dof);
-  if (!only.empty())
-    out.erase(std::remove_if(out.begin(), out.end(),
-                             [&](const BenchScene& s) { return s.name.find(only) == std::string::npos; }),
-              out.end());
-  return out;
+  if (only.empty()) return out;
+  std::vector<BenchScene> kept;
+  std::string names;
+  for (const BenchScene& s : out) {
+    if (s.name.find(only) != std::string::npos) kept.push_back(s);
+    names += (names.empty() ? "" : ", ") + s.name;
+  }
+  if (kept.empty()) {  // an empty table would read as a result
+    std::fprintf(stderr, "%s: --scene '%s' matches none of: %s\n", prog, only.c_str(), names.c_str());
+    std::exit(2);
+  }
+  return kept;
 }
 
 // The comparison framing: the course's 800x600 view scaled to 480x360 (keep_fov), one

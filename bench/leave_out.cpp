@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -46,10 +48,27 @@ bool exists(const std::string& p) {
   return stat(p.c_str(), &st) == 0;
 }
 
+const char* kUsage = "bench_leave_out [runs=3] [scene.dae ...]   (default scenes: the course's in ../shared and ours)";
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
+  int runs = 3;
+  if (argc > 1) {
+    const std::string a = argv[1];
+    char* end = nullptr;
+    const long v = std::strtol(a.c_str(), &end, 10);
+    if (a == "-h" || a == "--help") {
+      std::printf("usage: %s\n", kUsage);
+      return 0;
+    }
+    if (a.empty() || *end != '\0' || v < 1 || v > 1000) {
+      std::fprintf(stderr, "bench_leave_out: runs must be a whole number from 1 to 1000, not '%s'\nusage: %s\n", a.c_str(),
+                   kUsage);
+      return 2;
+    }
+    runs = int(v);
+  }
   std::vector<std::string> scenes;
   for (int i = 2; i < argc; ++i) scenes.push_back(argv[i]);
   if (scenes.empty()) {
@@ -66,7 +85,14 @@ int main(int argc, char** argv) {
   ProgressBar bar("bench_leave_out");
   int done = 0, total = int(scenes.size()) * runs * 2;
   for (const std::string& path : scenes) {
-    SceneDesc desc = load_collada(path);
+    SceneDesc desc;
+    try {
+      desc = load_collada(path);
+    } catch (const std::exception& e) {  // the message names the file and what is wrong
+      bar.finish();
+      std::fprintf(stderr, "bench_leave_out: %s\n", e.what());
+      return 1;
+    }
     RenderParams p;
     p.width = 240;
     p.height = 180;

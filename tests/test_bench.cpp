@@ -102,3 +102,28 @@ TEST(BenchSmoke, UnknownFlagIsRefused) {
   std::string out;
   EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --no-such-flag", out), 2) << out;
 }
+
+// A --scene that matches nothing is an error naming the scenes, not an empty table that reads as
+// a result.
+TEST(BenchSmoke, SceneMatchingNothingIsRefused) {
+  std::string out;
+  EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_ceiling --scene no-such-scene", out), 2) << out;
+  EXPECT_NE(out.find("--scene 'no-such-scene' matches none of: "), std::string::npos) << out;
+  EXPECT_NE(out.find("dof"), std::string::npos) << out;
+  EXPECT_EQ(out.find("PT rays/s"), std::string::npos) << out;  // no table
+}
+
+// bench_leave_out takes positional arguments: --help prints them instead of running, a runs count
+// that is not a number and an unreadable scene are errors that name the argument or the file.
+TEST(BenchSmoke, LeaveOutArgumentsAreChecked) {
+  const std::string bin = std::string(PT_BENCH_DIR) + "/bench_leave_out";
+  std::string out;
+  EXPECT_EQ(run(bin + " --help", out), 0) << out;
+  EXPECT_NE(out.find("usage: bench_leave_out [runs=3] [scene.dae ...]"), std::string::npos) << out;
+  EXPECT_EQ(out.find("specialised"), std::string::npos) << out;  // no benchmark ran
+  EXPECT_EQ(run(bin + " five", out), 2) << out;
+  EXPECT_NE(out.find("not 'five'"), std::string::npos) << out;
+  const std::string missing = pt::test::temp_dir() + "/no-such-scene.dae";
+  EXPECT_EQ(run(bin + " 1 " + missing, out), 1) << out;
+  EXPECT_NE(out.find(missing + ": cannot open file"), std::string::npos) << out;
+}
