@@ -3,7 +3,10 @@
 # Usage: bench/core_throughput.sh [runs=3]   (needs ../shared/scenes-cs184 and a built ./build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+usage="usage: bench/core_throughput.sh [runs=3]"
+case "${1:-}" in -h|--help) echo "$usage"; exit 0 ;; esac
 runs=${1:-3}
+[[ "$runs" =~ ^[1-9][0-9]*$ ]] || { echo "core_throughput.sh: runs must be a positive whole number, not '$runs'" >&2; echo "$usage" >&2; exit 2; }
 S=../shared/scenes-cs184
 [ -d "$S" ] || { echo "bench: $S is absent"; exit 0; }
 out=$(mktemp -d)

@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# Paths in packets of 16 against one path at a time (--no-ray-packets): samples/s of the pathtracer
+# Paths in Embree packets (16 rays, 8 without AVX-512) against one path at a time (--no-ray-packets): samples/s of the pathtracer
 # in the comparison framing (480x360 --keep-fov, 64 spp, -l 1, m = 5, no adaptive, 2 threads; dof
 # through its thin lens), the two runs interleaved, medians of N.
 # Usage: bench/packets_ab.sh [runs=5]   (a built ./build; the course scenes need ../shared/scenes-cs184)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+usage="usage: bench/packets_ab.sh [runs=5]"
+case "${1:-}" in -h|--help) echo "$usage"; exit 0 ;; esac
 runs=${1:-5}
+[[ "$runs" =~ ^[1-9][0-9]*$ ]] || { echo "packets_ab.sh: runs must be a positive whole number, not '$runs'" >&2; echo "$usage" >&2; exit 2; }
 S=../shared/scenes-cs184
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
