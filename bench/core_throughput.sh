@@ -10,12 +10,17 @@ runs=${1:-3}
 S=../shared/scenes-cs184
 [ -d "$S" ] || { echo "bench: $S is absent"; exit 0; }
 out=$(mktemp -d)
+source bench/progress.sh
+start=$(date +%s.%N) done=0 total=$((3 * runs))
 run_case() {  # name, args...
   local name=$1; shift
   local lines=()
   for i in $(seq "$runs"); do
+    progress "${name%% *} run $i/$runs" "$done" "$total" "$start"
     lines+=("$(./build/pathtracer --quiet "$@" -f "$out/img.png" | tail -1)")
+    done=$((done + 1))
   done
+  progress_clear
   printf '%s\n' "${lines[@]}" | python3 -c '
 import sys, re, statistics
 rows = [l for l in sys.stdin.read().splitlines() if l]

@@ -23,6 +23,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests/server"))
 from support import Contract, Server  # noqa: E402  (the tests' process helpers)
 
+from progress import clear, progress  # noqa: E402
+
 JOB = {"scene": "cornell", "width": 160, "height": 120, "spp": 32, "max_depth": 5, "adaptive": False, "tile_size": 16}
 JOBS, WATCHERS, POLLERS = 20, 50, 4
 
@@ -114,11 +116,14 @@ def main():
     NICE = not args.no_nice
     contract = Contract.load()
     results = {False: [], True: []}
+    started = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="load-bench-") as tmp:
         for i in range(args.runs):  # interleaved, so a change in the machine's load hits both alike
             for loaded in (False, True):
+                progress(f"batch {'with load' if loaded else 'alone'}", (2 * i + loaded) / (2 * args.runs), started)
                 results[loaded].append(run_batch(tmp, f"{'loaded' if loaded else 'alone'}-{i}", args.threads,
                                                  contract, loaded, seed=i + 1))
+    clear()
     rate = {k: statistics.median(r[0] for r in v) for k, v in results.items()}
     hwm = {k: max(r[3] for r in v) for k, v in results.items()}
     lat = sorted(x for r in results[True] for x in r[1])

@@ -12,16 +12,21 @@ runs=${1:-5}
 S=../shared/scenes-cs184
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
+source bench/progress.sh
+start=$(date +%s.%N) done=0 total=$((4 * runs))
 rate() { ./build/pathtracer -t 2 -s 64 -l 1 -m 5 -r 480 360 --no-adaptive -f "$out/v.exr" "$@" 2>/dev/null | tail -1 |
          grep -o '[0-9.e+]* samples/s' | cut -d' ' -f1; }
 for s in CBspheres CBbunny CBdragon dof; do
   if [ "$s" = dof ]; then f=scenes/dof.dae; x=(-b 0.12 -d 4.7); else f=$S/$s.dae; x=(--keep-fov); fi
   if [ ! -f "$f" ]; then echo "$s: skipped ($f is absent)"; continue; fi
   a=(); b=()
-  for _ in $(seq "$runs"); do
+  for i in $(seq "$runs"); do
+    progress "$s run $i/$runs" "$done" "$total" "$start"
     a+=("$(rate "${x[@]}" "$f")")
     b+=("$(rate "${x[@]}" --no-ray-packets "$f")")
+    done=$((done + 1))
   done
+  progress_clear
   python3 - "$s" "${a[*]}" "${b[*]}" <<'PY'
 import statistics as st, sys
 name, a, b = sys.argv[1], [float(x) for x in sys.argv[2].split()], [float(x) for x in sys.argv[3].split()]

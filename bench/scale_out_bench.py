@@ -19,6 +19,8 @@ import time
 import urllib.request
 from pathlib import Path
 
+from progress import clear, progress
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -33,16 +35,6 @@ def http(url, body=None):
                                  headers={"Content-Type": "application/json"})
     with urllib.request.urlopen(req, timeout=30) as r:
         return json.loads(r.read())
-
-
-def progress(label, fraction, started):
-    if not sys.stderr.isatty():
-        return
-    el = time.monotonic() - started
-    eta = el * (1 - fraction) / fraction if fraction > 0 else float("nan")
-    bar = "#" * int(30 * fraction)
-    sys.stderr.write(f"\r{label:<14} [{bar:<30}] {100 * fraction:5.1f}%  ETA {eta:5.1f} s ")
-    sys.stderr.flush()
 
 
 def run_job(build, tmp, spec, queue_url, workers, threads, label):
@@ -111,8 +103,7 @@ def main():
             for label, workers in setups:
                 runs[label].append(run_job(build, tmp, spec, url if workers else None, workers, a.threads,
                                            label.replace(" ", "-")))
-        if sys.stderr.isatty():
-            sys.stderr.write("\r" + " " * 70 + "\r")
+        clear()
         baseline, sizes = None, {}
         for label, _ in setups:
             sec = statistics.median(r[0] for r in runs[label])

@@ -16,6 +16,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests/server"))
 from support import Contract, Server  # noqa: E402  (the tests' process and stream helpers)
 
+from progress import clear, progress  # noqa: E402
+
 FIRST_TILE_JOB = {"scene": "cornell", "width": 320, "height": 240, "spp": 64, "max_depth": 5}
 THROUGHPUT_JOB = {"scene": "cornell", "width": 320, "height": 240, "spp": 32, "max_depth": 5, "adaptive": False,
                   "tile_size": 32}
@@ -109,19 +111,32 @@ def main():
     ap.add_argument("--runs", type=int, default=3, help="throughput runs per watcher count (median)")
     args = ap.parse_args()
     contract = Contract.load()
+    started, steps, done = time.monotonic(), 5 + 2 * args.runs + 2, 0
+
+    def step(label):
+        nonlocal done
+        progress(label, done / steps, started)
+        done += 1
+
     with tempfile.TemporaryDirectory(prefix="server-bench-") as tmp:
         srv = start(tmp, "main", args.threads, contract)
         try:
             srv.api.post("/api/jobs/check", FIRST_TILE_JOB, expect=200)  # warm the scene cache
-            lat = [first_tile_latency(srv, seed) for seed in range(1, 6)]
+            lat = []
+            for seed in range(1, 6):
+                step("(a) first tile")
+                lat.append(first_tile_latency(srv, seed))
             kinds = {k for _, k in lat}
+            clear()
             print(f"(a) POST -> first tile event: median {statistics.median(t for t, _ in lat) * 1000:.1f} ms "
                   f"(5 runs: {', '.join(f'{t * 1000:.1f}' for t, _ in lat)} ms; first pixel event: {'/'.join(sorted(kinds))}; "
                   f"job {FIRST_TILE_JOB['width']}x{FIRST_TILE_JOB['height']}, {args.threads} threads)")
             rates, results = {}, {0: [], 10: []}
             for i in range(args.runs):  # interleaved, so a change in the machine's load hits both alike
                 for watchers in results:
+                    step(f"(b) {watchers} watchers")
                     results[watchers].append(throughput(srv, watchers, seed=10 + i))
+            clear()
             for watchers, runs in results.items():
                 rates[watchers] = statistics.median(r for r, _ in runs)
                 sent = f"; {statistics.median(b for _, b in runs) / 1e6:.2f} MB to each watcher" if watchers else ""
@@ -132,8 +147,11 @@ def main():
                   f"{THROUGHPUT_JOB['tile_size']}-pixel tiles)")
         finally:
             srv.kill()
+        step("(c) peak RSS")
         plain = peak_rss(tmp, "rss-plain", args.threads, contract, stalled=False)
+        step("(c) peak RSS, stalled")
         stalled = peak_rss(tmp, "rss-stalled", args.threads, contract, stalled=True)
+        clear()
         print(f"(c) peak RSS (VmHWM) over a {LONG_JOB['width']}x{LONG_JOB['height']} {LONG_JOB['spp']} spp job: "
               f"{plain:.1f} MiB without a watcher, {stalled:.1f} MiB with one stalled watcher "
               f"({stalled - plain:+.1f} MiB)")

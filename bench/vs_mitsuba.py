@@ -29,6 +29,8 @@ import sys
 import time
 from pathlib import Path
 
+from progress import clear, progress
+
 ROOT = Path(__file__).resolve().parents[1]
 BUILD = ROOT / "build"
 VENV = BUILD / "mitsuba-venv"
@@ -56,16 +58,6 @@ def find_libllvm():
             if hits:
                 return str(hits[0])
     return None
-
-
-def progress(label, done, total, started):
-    if not sys.stderr.isatty():
-        return
-    el = time.monotonic() - started
-    frac = done / total if total else 1
-    eta = el * (1 - frac) / frac if frac > 0 else float("nan")
-    sys.stderr.write(f"\r{label:<28} [{'#' * int(30 * frac):<30}] {100 * frac:5.1f}%  ETA {eta:6.1f} s ")
-    sys.stderr.flush()
 
 
 def rel_mse(np, img, ref):
@@ -189,7 +181,7 @@ def main():
         if mref_path.exists():
             mref = np.load(mref_path)
         else:
-            progress(f"{name}: Mitsuba reference", 0, 1, started)
+            progress(f"{name}: Mitsuba reference", 0, started)
             scene = mitsuba_scene(mi, folder, depth, args.ref_spp)
             mref = np.array(mi.render(scene, seed=7919))
             np.save(mref_path, mref)
@@ -197,7 +189,7 @@ def main():
         np.array(mi.render(scene, seed=1))
         mt, me = [], []
         for k in range(args.runs):
-            progress(f"{name}: Mitsuba", k, args.runs, started)
+            progress(f"{name}: Mitsuba", k / args.runs, started)
             t0 = time.perf_counter()
             img = np.array(mi.render(scene, seed=100 + k))
             mt.append(time.perf_counter() - t0)
@@ -205,19 +197,18 @@ def main():
         # Ours: reference (cached EXR), timed runs.
         oref_path = cache / f"ours-{name}-m{depth}-{args.ref_spp}-{args.sampler or 'default'}.exr"
         if not oref_path.exists():
-            progress(f"{name}: our reference", 0, 1, started)
+            progress(f"{name}: our reference", 0, started)
             run_ours(args, SHARED / file, depth, args.ref_spp, oref_path, 7919)
         oref = np.array(mi.Bitmap(str(oref_path)))
         ot, orate, oe = [], [], []
         out = cache / f"ours-{name}-run.exr"
         for k in range(args.runs):
-            progress(f"{name}: ours", k, args.runs, started)
+            progress(f"{name}: ours", k / args.runs, started)
             sec, rate = run_ours(args, SHARED / file, depth, args.spp, out, 100 + k, args.ours.split())
             ot.append(sec)
             orate.append(rate)
             oe.append(rel_mse(np, np.array(mi.Bitmap(str(out))), oref))
-        if sys.stderr.isatty():
-            sys.stderr.write("\r" + " " * 90 + "\r")
+        clear()
         lum = np.array([0.2126, 0.7152, 0.0722])
         mean_m, mean_o = float(np.mean(mref[..., :3] @ lum)), float(np.mean(oref[..., :3] @ lum))
         cross = rel_mse(np, mref, oref)
