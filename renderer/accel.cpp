@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -16,10 +15,7 @@
 #include <vector>
 
 #include "accel_math.h"
-
-#if defined(__x86_64__) || defined(__i386__)
-#include <x86intrin.h>
-#endif
+#include "accel_probe.h"
 
 namespace pt {
 
@@ -309,53 +305,6 @@ inline void to_embree(const Ray& r, RTCRay& e) {
   e.flags = 0;
 }
 
-thread_local RayRecorder* t_recorder = nullptr;  // benchmarks only: see record_rays_on_this_thread
-
-// Out of line and cold, so the unset case stays one thread-local load and a branch.
-[[gnu::noinline, gnu::cold]] void record_ray(const Ray& ray, uint8_t shadow) {
-  t_recorder->rays.push_back(ray);
-  t_recorder->shadow.push_back(shadow);
-}
-
-}  // namespace
-
-void record_rays_on_this_thread(RayRecorder* r) { t_recorder = r; }
-
-uint64_t accel_ticks() {
-#if defined(__x86_64__) || defined(__i386__)
-  return __rdtsc();
-#else
-  return uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
-#endif
-}
-
-namespace {
-
-thread_local AccelTimer* t_timer = nullptr;  // benchmarks only: see time_accel_on_this_thread
-
-// Adds the time from its construction to the end of its scope to one field of the thread's
-// timer, where one is set.
-class TimeInto {
- public:
-  explicit TimeInto(uint64_t AccelTimer::*field)
-      : m_into(__builtin_expect(t_timer != nullptr, 0) ? &(t_timer->*field) : nullptr), m_t0(m_into ? accel_ticks() : 0) {}
-  ~TimeInto() {
-    if (__builtin_expect(m_into != nullptr, 0)) *m_into += accel_ticks() - m_t0;
-  }
-  TimeInto(const TimeInto&) = delete;
-  TimeInto& operator=(const TimeInto&) = delete;
-
- private:
-  uint64_t* m_into;
-  uint64_t m_t0;
-};
-
-}  // namespace
-
-void time_accel_on_this_thread(AccelTimer* t) { t_timer = t; }
-
-namespace {
-
 // The hit record from Embree's answer: the point refined from the barycentrics or the sphere
 // equation, unit normals, material and light. `eng` is Embree's unnormalised geometric normal.
 // Inlined into the packet loop: as a call, its eight arguments and prologue cost 1.2% of CBbunny's
@@ -408,11 +357,11 @@ struct Packet<8> {
   using RayHit = RTCRayHit8;
   using Ray = RTCRay8;
   static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) {
-    TimeInto timed(&AccelTimer::embree);
+    probe::TimeInto timed(&AccelTimer::embree);
     rtcIntersect8(valid, s, c, r);
   }
   static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) {
-    TimeInto timed(&AccelTimer::embree);
+    probe::TimeInto timed(&AccelTimer::embree);
     rtcOccluded8(valid, s, c, r);
   }
 };
@@ -421,11 +370,11 @@ struct Packet<16> {
   using RayHit = RTCRayHit16;
   using Ray = RTCRay16;
   static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) {
-    TimeInto timed(&AccelTimer::embree);
+    probe::TimeInto timed(&AccelTimer::embree);
     rtcIntersect16(valid, s, c, r);
   }
   static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) {
-    TimeInto timed(&AccelTimer::embree);
+    probe::TimeInto timed(&AccelTimer::embree);
     rtcOccluded16(valid, s, c, r);
   }
 };
@@ -477,7 +426,7 @@ struct Lanes {
 }  // namespace
 
 bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
-  if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(ray, 0);
+  probe::record(ray, 0);
   if (!embree_accepts(ray)) return false;
   const Impl& a = *m_impl;
   if (a.cull && !may_hit_bounds(ray, a.lo, a.hi)) return false;
@@ -488,11 +437,11 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   {
-    TimeInto timed(&AccelTimer::embree);
+    probe::TimeInto timed(&AccelTimer::embree);
     rtcIntersect1(m_impl->scene, &ctx, &rh);
   }
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  TimeInto timed(&AccelTimer::refine);
+  probe::TimeInto timed(&AccelTimer::refine);
   refine_hit(a.geoms[rh.hit.geomID], ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v,
              Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), hit);
   return true;
@@ -537,7 +486,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
   auto trace = [&] {
     lanes.seal(at, rh.ray);
     Packet<K>::intersect(lanes.valid, a.scene, &ctx, &rh);
-    TimeInto timed(&AccelTimer::refine);
+    probe::TimeInto timed(&AccelTimer::refine);
     for (int k = 0; k < lanes.used; ++k) {
       const uint32_t i = lanes.ray[k];
       if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
@@ -550,7 +499,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
   for (size_t i = 0; i < n; ++i) {
     found[i] = 0;
     const Ray& r = at[i];
-    if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(r, 0);
+    probe::record(r, 0);
     if (!embree_accepts(r) || (a.cull && !may_hit_bounds(r, a.lo, a.hi))) continue;
     rh.hit.geomID[lanes.used] = rh.hit.instID[0][lanes.used] = RTC_INVALID_GEOMETRY_ID;
     if (lanes.add(at, uint32_t(i), rh.ray)) trace();
@@ -574,7 +523,7 @@ void occluded_packets(const Accel::Impl& a, const Ray* rays, size_t n, uint8_t* 
   for (size_t i = 0; i < n; ++i) {
     blocked[i] = 0;
     const Ray& r = rays[i];
-    if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(r, 1);
+    probe::record(r, 1);
     if (!embree_accepts(r)) continue;
     if (lanes.add(rays, uint32_t(i), rk)) trace();
   }
@@ -584,14 +533,14 @@ void occluded_packets(const Accel::Impl& a, const Ray* rays, size_t n, uint8_t* 
 }  // namespace
 
 bool Accel::occluded(const Ray& ray) const {
-  if (__builtin_expect(t_recorder != nullptr, 0)) record_ray(ray, 1);
+  probe::record(ray, 1);
   if (!embree_accepts(ray)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRay r;
   to_embree(ray, r);
   {
-    TimeInto timed(&AccelTimer::embree);
+    probe::TimeInto timed(&AccelTimer::embree);
     rtcOccluded1(m_impl->scene, &ctx, &r);
   }
   return r.tfar < 0;  // Embree sets tfar = -inf on a hit
@@ -646,7 +595,7 @@ size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode
         RTCRay r;
         to_embree(rays[i], r);
         {
-          TimeInto timed(&AccelTimer::embree);
+          probe::TimeInto timed(&AccelTimer::embree);
           rtcOccluded1(scene, &ctx, &r);
         }
         hits += r.tfar < 0;
@@ -656,7 +605,7 @@ size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         {
-          TimeInto timed(&AccelTimer::embree);
+          probe::TimeInto timed(&AccelTimer::embree);
           rtcIntersect1(scene, &ctx, &rh);
         }
         hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
@@ -669,7 +618,7 @@ size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode
   size_t nh = 0, ns = 0;
   auto flush_hits = [&] {
     {
-      TimeInto timed(&AccelTimer::embree);
+      probe::TimeInto timed(&AccelTimer::embree);
       rtcIntersect1M(scene, &ctx, hit_rays.data(), unsigned(nh), sizeof(RTCRayHit));
     }
     for (size_t k = 0; k < nh; ++k) hits += hit_rays[k].hit.geomID != RTC_INVALID_GEOMETRY_ID;
@@ -677,7 +626,7 @@ size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode
   };
   auto flush_shadows = [&] {
     {
-      TimeInto timed(&AccelTimer::embree);
+      probe::TimeInto timed(&AccelTimer::embree);
       rtcOccluded1M(scene, &ctx, shadow_rays.data(), unsigned(ns), sizeof(RTCRay));
     }
     for (size_t k = 0; k < ns; ++k) hits += shadow_rays[k].tfar < 0;

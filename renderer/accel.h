@@ -93,8 +93,8 @@ void record_rays_on_this_thread(RayRecorder* r);
 
 // Benchmarks only: where a thread's time goes around Embree, in ticks of accel_ticks()'s clock.
 // `embree` sums the Embree calls themselves (every intersect and occluded query, raw replays
-// included); `refine` sums the hit refinement after packet intersections (refine_hit: the hit
-// point, normals, material). bench_ceiling splits the path tracer's time with them.
+// included); `refine` sums the refinement of their hits (the hit point, normals, material), which
+// the raw replays skip. bench_ceiling splits the path tracer's time with them.
 struct AccelTimer {
   uint64_t embree = 0, refine = 0;
 };
