@@ -40,23 +40,16 @@ bool on_memory(void* user, ssize_t bytes, bool) {
 
 enum class GeomKind { mesh, spheres, panels };
 
-// What a hit on a triangle needs besides its vertices, in one record so that one cache line
-// serves the fetch: the unit face normal is computed once here instead of at every hit.
-struct TriangleInfo {
-  Vec3 ng;        // normalize(cross(p1 - p0, p2 - p0)); zero for a degenerate triangle
-  int material;
-  int light;      // -1 unless the triangle is an emitter registered as a light
-};
-
 struct GeomInfo {
   GeomKind kind = GeomKind::mesh;
   const float* positions = nullptr;   // Embree-owned vertex buffer (3 floats a vertex)
   const uint32_t* indices = nullptr;  // Embree-owned index buffer
-  std::vector<Vec3> normals;          // shading normals, empty for flat meshes
+  std::vector<float> normals;         // shading normals, 3 floats a vertex and 1 of padding; empty for flat meshes
   std::vector<TriangleInfo> tris;     // per triangle
   const float* spheres = nullptr;     // x y z r per sphere
   std::vector<float> sphere_data;     // what `spheres` points to (Embree user geometry reads it)
   std::vector<int> sphere_material;
+  TriangleData triangles{};  // a view of the above for refine_triangle, set once all geometry is in place
 };
 
 void sphere_bounds(const RTCBoundsFunctionArguments* args) {
@@ -193,7 +186,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
       Vec3 p0 = pos[tri[0]], p1 = pos[tri[1]], p2 = pos[tri[2]];
       info.tris[t] = {normalize(cross(p1 - p0, p2 - p0)), tri_material[t], tri_light.empty() ? -1 : tri_light[t]};
     }
-    a.bytes += info.normals.size() * sizeof(Vec3) + info.tris.size() * sizeof(TriangleInfo);
+    a.bytes += info.normals.size() * sizeof(float) + info.tris.size() * sizeof(TriangleInfo);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a.scene, g);
     rtcReleaseGeometry(g);
@@ -208,7 +201,11 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     const MeshDesc& mesh = desc.meshes[m];
     GeomInfo info;
     info.kind = GeomKind::mesh;
-    info.normals = mesh.normals;
+    if (!mesh.normals.empty()) {  // padded for refine_triangle's 16-byte loads
+      info.normals.reserve(3 * mesh.normals.size() + 1);
+      for (Vec3 n : mesh.normals) info.normals.insert(info.normals.end(), {n.x, n.y, n.z});
+      info.normals.push_back(0.0f);
+    }
     static const std::vector<int> none;
     add_triangles(mesh.positions, mesh.indices, mesh.tri_material, m < mesh_light.size() ? mesh_light[m] : none,
                   std::move(info));
@@ -257,6 +254,8 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     if (a.geoms.size() <= id) a.geoms.resize(id + 1);
     a.geoms[id] = std::move(info);
   }
+  for (GeomInfo& g : a.geoms)  // the vectors' buffers are where they stay
+    g.triangles = {g.positions, g.indices, g.normals.empty() ? nullptr : g.normals.data(), g.tris.data()};
 
   rtcCommitScene(a.scene);
   a.check("building the BVH");
@@ -305,48 +304,15 @@ inline void to_embree(const Ray& r, RTCRay& e) {
   e.flags = 0;
 }
 
-// The hit record from Embree's answer: the point refined from the barycentrics or the sphere
-// equation, unit normals, material and light. `eng` is Embree's unnormalised geometric normal.
-// Inlined into the packet loop: as a call, its eight arguments and prologue cost 1.2% of CBbunny's
-// instructions (docs/performance.md, ninth session).
+// The hit record from Embree's answer (accel_math.h). `eng()` gives Embree's unnormalised
+// geometric normal, read only for a degenerate triangle. Inlined into the packet loop: as a call,
+// its eight arguments and prologue cost 1.2% of CBbunny's instructions (docs/performance.md,
+// ninth session).
+template <class EmbreeNormal>
 [[gnu::always_inline]] inline void refine_hit(const GeomInfo& g, const Ray& ray, unsigned prim, float t, float u,
-                                              float v, Vec3 eng, SurfaceHit& hit) {
-  hit.t = t;
-  if (g.kind == GeomKind::spheres) {
-    const float* s = g.spheres + 4 * prim;
-    Vec3 c(s[0], s[1], s[2]);
-    float r = s[3];
-    Vec3 p = ray.o + ray.d * t;
-    Vec3 n = normalize(p - c);
-    if (is_black(n)) n = Vec3(0, 1, 0);
-    hit.p = c + n * r;  // re-project onto the sphere: removes the error of o + t d
-    hit.ng = hit.ns = n;
-    hit.material = g.sphere_material[prim];
-    hit.light = -1;
-    // Embree's sphere test loses ~ulp(r)/cos near the surface; push far enough to clear it.
-    hit.offset = 1e-5f * r;
-    return;
-  }
-  const uint32_t* tri = g.indices + 3 * prim;
-  const TriangleInfo& info = g.tris[prim];
-  auto P = [&](uint32_t i) { return Vec3(g.positions[3 * i], g.positions[3 * i + 1], g.positions[3 * i + 2]); };
-  float w = 1 - u - v;
-  hit.p = P(tri[0]) * w + P(tri[1]) * u + P(tri[2]) * v;
-  Vec3 ng = info.ng;
-  if (__builtin_expect(is_black(ng), 0)) {
-    ng = normalize(eng);
-    if (is_black(ng)) ng = Vec3(0, 1, 0);
-  }
-  hit.ng = ng;
-  if (!g.normals.empty()) {
-    Vec3 ns = normalize(g.normals[tri[0]] * w + g.normals[tri[1]] * u + g.normals[tri[2]] * v);
-    hit.ns = is_black(ns) ? ng : ns;
-  } else {
-    hit.ns = ng;
-  }
-  hit.material = info.material;
-  hit.light = info.light;
-  hit.offset = 0;
+                                              float v, EmbreeNormal&& eng, SurfaceHit& hit) {
+  if (g.kind == GeomKind::spheres) refine_sphere(g.spheres + 4 * size_t(prim), g.sphere_material[prim], ray, t, hit);
+  else refine_triangle(g.triangles, prim, t, u, v, eng, hit);
 }
 
 // Embree's packet types and calls for packets of K rays.
@@ -443,7 +409,7 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   probe::TimeInto timed(&AccelTimer::refine);
   refine_hit(a.geoms[rh.hit.geomID], ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v,
-             Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), hit);
+             [&] { return Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z); }, hit);
   return true;
 }
 
@@ -492,7 +458,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
       if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
       found[i] = 1;
       refine_hit(a.geoms[rh.hit.geomID[k]], at[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
-                 Vec3(rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]), hits[i]);
+                 [&] { return Vec3(rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]); }, hits[i]);
     }
     lanes.used = 0;
   };

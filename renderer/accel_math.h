@@ -1,15 +1,20 @@
-// The ray tests Accel runs around Embree, in plain maths (no Embree types, so that tests can check
-// them directly): Embree's input range, the scene-bounds slab test and the analytic sphere, each
-// with an SSE form that gives the scalar form's bits.
+// The ray tests and hit refinement Accel runs around Embree, in plain maths (no Embree types, so
+// that tests can check them directly): Embree's input range, the scene-bounds slab test, the
+// analytic sphere and the hit records of triangles and spheres, each with an SSE form that gives
+// the scalar form's bits.
 #pragma once
 
 #include <cmath>
 #include <utility>
 
+#include <cstddef>
+#include <cstring>
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
+#include "accel.h"
 #include "math.h"
 
 namespace pt {
@@ -150,6 +155,155 @@ inline int sphere_hit4(const float* s, const RayLanes4& r, float t[4]) {
     if (r.valid[k] == -1 && sphere_hit(s, r.ox[k], r.oy[k], r.oz[k], r.dx[k], r.dy[k], r.dz[k], r.tnear[k], r.tfar[k], t[k]))
       mask |= 1 << k;
   return mask;
+#endif
+}
+
+// What a hit on a triangle needs besides its vertices, in one record so that one cache line
+// serves the fetch: the unit face normal is computed once at load instead of at every hit.
+struct TriangleInfo {
+  Vec3 ng;        // normalize(cross(p1 - p0, p2 - p0)); zero for a degenerate triangle
+  int material;
+  int light;      // -1 unless the triangle is an emitter registered as a light
+};
+
+// A triangle mesh as hit refinement reads it. Positions and normals hold 3 floats a vertex, and
+// each vertex must be readable with one 16-byte load (Embree pads its vertex buffers so; Accel
+// pads the normals): the SSE form loads x y z and one float beyond.
+struct TriangleData {
+  const float* positions;
+  const uint32_t* indices;
+  const float* normals;  // shading normals, or null for a flat mesh
+  const TriangleInfo* tris;
+};
+
+// The hit record of a hit on triangle `prim` at t with barycentrics (u, v): the point from the
+// barycentrics (not o + t d, which drifts off the plane), the unit face normal (for a degenerate
+// triangle, from `eng()`: Embree's unnormalised one), the interpolated shading normal, material, light.
+template <class EmbreeNormal>
+inline void refine_triangle_scalar(const TriangleData& m, unsigned prim, float t, float u, float v, EmbreeNormal&& eng,
+                                   SurfaceHit& hit) {
+  const uint32_t* tri = m.indices + 3 * size_t(prim);
+  const TriangleInfo& info = m.tris[prim];
+  auto at = [&](const float* base, uint32_t i) { return Vec3(base[3 * size_t(i)], base[3 * size_t(i) + 1], base[3 * size_t(i) + 2]); };
+  const float w = 1 - u - v;
+  hit.t = t;
+  hit.p = at(m.positions, tri[0]) * w + at(m.positions, tri[1]) * u + at(m.positions, tri[2]) * v;
+  Vec3 ng = info.ng;
+  if (is_black(ng)) {
+    ng = normalize(eng());
+    if (is_black(ng)) ng = Vec3(0, 1, 0);
+  }
+  hit.ng = ng;
+  hit.ns = ng;
+  if (m.normals) {
+    Vec3 ns = normalize(at(m.normals, tri[0]) * w + at(m.normals, tri[1]) * u + at(m.normals, tri[2]) * v);
+    if (!is_black(ns)) hit.ns = ns;
+  }
+  hit.material = info.material;
+  hit.light = info.light;
+  hit.offset = 0;
+}
+
+// The hit record of a hit on sphere s (centre x y z, radius) at t: the point re-projected onto the
+// sphere, which removes the error of o + t d, and the outward normal.
+inline void refine_sphere_scalar(const float* s, int material, const Ray& ray, float t, SurfaceHit& hit) {
+  const Vec3 c(s[0], s[1], s[2]);
+  const float r = s[3];
+  Vec3 n = normalize(ray.o + ray.d * t - c);
+  if (is_black(n)) n = Vec3(0, 1, 0);
+  hit.t = t;
+  hit.p = c + n * r;
+  hit.ng = hit.ns = n;
+  hit.material = material;
+  hit.light = -1;
+  // Embree's sphere test loses ~ulp(r)/cos near the surface; push far enough to clear it.
+  hit.offset = 1e-5f * r;
+}
+
+#if defined(__SSE2__)
+namespace sse {
+
+// normalize() of lanes x y z, with its operations in its order: the same bits (lane 3 is zero or
+// garbage).
+[[gnu::always_inline]] inline __m128 normalize3(__m128 a) {
+  const __m128 sq = _mm_mul_ps(a, a);
+  const __m128 d = _mm_add_ss(_mm_add_ss(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(1, 1, 1, 1))), _mm_movehl_ps(sq, sq));
+  const float l = _mm_cvtss_f32(_mm_sqrt_ss(d));
+  return l > 0 ? _mm_mul_ps(a, _mm_set1_ps(1.0f / l)) : _mm_setzero_ps();
+}
+[[gnu::always_inline]] inline bool is_black3(__m128 a) {
+  return (_mm_movemask_ps(_mm_cmpeq_ps(a, _mm_setzero_ps())) & 7) == 7;
+}
+// a0 w + a1 u + a2 v of the vertices' x y z, in the scalar form's order.
+[[gnu::always_inline]] inline __m128 interpolate(const float* base, const uint32_t* tri, __m128 w, __m128 u, __m128 v) {
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(base + 3 * size_t(tri[0])), w),
+                               _mm_mul_ps(_mm_loadu_ps(base + 3 * size_t(tri[1])), u)),
+                    _mm_mul_ps(_mm_loadu_ps(base + 3 * size_t(tri[2])), v));
+}
+
+// The record's three vectors stored 16 bytes at a time, in field order: each store's fourth float
+// spills into the next field, which the next store (or the caller's) then writes.
+static_assert(offsetof(SurfaceHit, ng) == offsetof(SurfaceHit, p) + 12 &&
+                  offsetof(SurfaceHit, ns) == offsetof(SurfaceHit, ng) + 12 &&
+                  offsetof(SurfaceHit, material) == offsetof(SurfaceHit, ns) + 12 &&
+                  offsetof(SurfaceHit, light) == offsetof(SurfaceHit, material) + 4,
+              "SurfaceHit: p, ng, ns, material and light back to back");
+[[gnu::always_inline]] inline void store_vectors(SurfaceHit& hit, __m128 p, __m128 ng, __m128 ns) {
+  _mm_storeu_ps(&hit.p.x, p);
+  _mm_storeu_ps(&hit.ng.x, ng);
+  _mm_storeu_ps(&hit.ns.x, ns);
+}
+
+}  // namespace sse
+#endif
+
+// refine_triangle_scalar's record with SSE: its bits, in about half the instructions (the hit
+// loop's refinement was a tenth of a mesh scene's pass; docs/performance.md, tenth session).
+template <class EmbreeNormal>
+[[gnu::always_inline]] inline void refine_triangle(const TriangleData& m, unsigned prim, float t, float u, float v,
+                                                   EmbreeNormal&& eng, SurfaceHit& hit) {
+#if defined(__SSE2__)
+  const uint32_t* tri = m.indices + 3 * size_t(prim);
+  const TriangleInfo& info = m.tris[prim];
+  const __m128 W = _mm_set1_ps(1 - u - v), U = _mm_set1_ps(u), V = _mm_set1_ps(v);
+  const __m128 p = sse::interpolate(m.positions, tri, W, U, V);
+  __m128 ng = _mm_loadu_ps(&info.ng.x);  // ng and the material's bits in lane 3
+  if (__builtin_expect(sse::is_black3(ng), 0)) {
+    Vec3 n = normalize(eng());
+    if (is_black(n)) n = Vec3(0, 1, 0);
+    ng = _mm_setr_ps(n.x, n.y, n.z, 0);
+  }
+  __m128 ns = ng;
+  if (m.normals) {
+    const __m128 n = sse::normalize3(sse::interpolate(m.normals, tri, W, U, V));
+    if (!sse::is_black3(n)) ns = n;
+  }
+  hit.t = t;
+  sse::store_vectors(hit, p, ng, ns);
+  std::memcpy(&hit.material, &info.material, 2 * sizeof(int));  // material and light, adjacent in both
+  hit.offset = 0;
+#else
+  refine_triangle_scalar(m, prim, t, u, v, eng, hit);
+#endif
+}
+
+// refine_sphere_scalar's record with SSE: its bits.
+[[gnu::always_inline]] inline void refine_sphere(const float* s, int material, const Ray& ray, float t,
+                                                 SurfaceHit& hit) {
+#if defined(__SSE2__)
+  static_assert(sizeof(Ray) == 8 * sizeof(float), "Ray is o, d, tmin, tmax without padding");
+  const __m128 sphere = _mm_loadu_ps(s);  // centre, radius
+  const __m128 o = _mm_loadu_ps(&ray.o.x), d = _mm_loadu_ps(&ray.d.x);
+  __m128 n = sse::normalize3(_mm_sub_ps(_mm_add_ps(o, _mm_mul_ps(d, _mm_set1_ps(t))), sphere));
+  if (sse::is_black3(n)) n = _mm_setr_ps(0, 1, 0, 0);
+  const float r = s[3];
+  hit.t = t;
+  sse::store_vectors(hit, _mm_add_ps(sphere, _mm_mul_ps(n, _mm_set1_ps(r))), n, n);
+  hit.material = material;
+  hit.light = -1;
+  hit.offset = 1e-5f * r;
+#else
+  refine_sphere_scalar(s, material, ray, t, hit);
 #endif
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include "accel_math.h"
 
@@ -136,4 +137,88 @@ TEST(AccelMath, FourSphereTestsAtOnceGiveTheScalarTestsBits) {
   }
   EXPECT_GT(hits, 30000);
   EXPECT_GT(misses, 30000);
+}
+
+namespace {
+
+bool same_record(const SurfaceHit& a, const SurfaceHit& b) {
+  const float fa[] = {a.t, a.p.x, a.p.y, a.p.z, a.ng.x, a.ng.y, a.ng.z, a.ns.x, a.ns.y, a.ns.z, a.offset};
+  const float fb[] = {b.t, b.p.x, b.p.y, b.p.z, b.ng.x, b.ng.y, b.ng.z, b.ns.x, b.ns.y, b.ns.z, b.offset};
+  for (size_t k = 0; k < sizeof fa / sizeof fa[0]; ++k)
+    if (!same_bits(fa[k], fb[k])) return false;
+  return a.material == b.material && a.light == b.light;
+}
+
+}  // namespace
+
+// refine_triangle's SSE loads read one float past each vertex, and it stores 16 bytes at a time
+// into the record: the records must still match the scalar form's bits field by field, for flat
+// and smooth meshes, degenerate triangles (the face normal from Embree's) and shading normals
+// that cancel out (the face normal instead).
+TEST(AccelMath, TriangleRefinementGivesTheScalarRecordsBits) {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<float> u01(0.f, 1.f), u(-3.f, 3.f);
+  const size_t nv = 64;
+  std::vector<float> positions(3 * nv + 1), normals(3 * nv + 1);  // one float of padding, as Accel keeps
+  for (size_t i = 0; i < 3 * nv; ++i) positions[i] = u(rng), normals[i] = u(rng);
+  for (size_t i = 0; i < 3; ++i) positions[3 * 5 + i] = positions[3 * 4 + i];  // vertices 4 and 5 coincide
+  for (size_t i = 0; i < 3; ++i) normals[3 * 7 + i] = -normals[3 * 6 + i];     // normals 6 and 7 cancel
+  std::vector<uint32_t> indices;
+  std::vector<TriangleInfo> tris;
+  for (int t = 0; t < 400; ++t) {
+    uint32_t a = rng() % nv, b = rng() % nv, c = rng() % nv;
+    if (t % 10 == 0) a = 4, b = 5;  // degenerate: two corners at one point
+    if (t % 10 == 1) a = 6, b = 7;  // the shading normal cancels halfway along edge ab
+    if (t == 399) a = b = c = uint32_t(nv - 1);  // the last vertex: its load reaches the padding
+    indices.insert(indices.end(), {a, b, c});
+    auto P = [&](uint32_t i) { return Vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); };
+    tris.push_back({normalize(cross(P(b) - P(a), P(c) - P(a))), int(rng() % 5), t % 3 == 0 ? int(rng() % 4) : -1});
+  }
+  int degenerate = 0, cancelled = 0;
+  for (const float* shading : {static_cast<const float*>(nullptr), static_cast<const float*>(normals.data())}) {
+    const TriangleData mesh{positions.data(), indices.data(), shading, tris.data()};
+    for (int k = 0; k < 20000; ++k) {
+      const unsigned prim = rng() % tris.size();
+      float bu = u01(rng), bv = u01(rng);
+      if (bu + bv > 1) bu = 1 - bu, bv = 1 - bv;
+      if (k % 7 == 0) bu = 0.5f, bv = 0;  // halfway along the first edge
+      const float t = 10 * u01(rng);
+      const Vec3 eng = k % 5 == 0 ? Vec3(0.0f) : Vec3(u(rng), u(rng), u(rng));  // a zero one: the fallback's fallback
+      SurfaceHit fast, slow;
+      fast.t = slow.t = -1;
+      refine_triangle(mesh, prim, t, bu, bv, [&] { return eng; }, fast);
+      refine_triangle_scalar(mesh, prim, t, bu, bv, [&] { return eng; }, slow);
+      ASSERT_TRUE(same_record(fast, slow)) << "triangle " << prim << " at (" << bu << ", " << bv << ")";
+      degenerate += is_black(tris[prim].ng);
+      if (shading && prim % 10 == 1 && k % 7 == 0) {  // the normals cancel: the face normal shades
+        ASSERT_EQ(slow.ns, slow.ng);
+        ++cancelled;
+      }
+    }
+  }
+  EXPECT_GT(degenerate, 1000);
+  EXPECT_GT(cancelled, 100);  // about 20000 / 7 / 10
+}
+
+// refine_sphere's record against the scalar form's, including a hit at the very centre (no
+// direction to normalise: the fallback normal) and rays far from the origin.
+TEST(AccelMath, SphereRefinementGivesTheScalarRecordsBits) {
+  std::mt19937 rng(22);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  for (int k = 0; k < 50000; ++k) {
+    const float scale = k % 4 == 0 ? 1e4f : 1.0f;
+    const float s[4] = {scale * u(rng), scale * u(rng), scale * u(rng), 0.01f + std::fabs(scale * u(rng))};
+    Ray ray;
+    ray.o = Vec3(s[0], s[1], s[2]) + Vec3(u(rng), u(rng), u(rng)) * (3 * s[3]);
+    ray.d = normalize(Vec3(u(rng), u(rng), u(rng)));
+    ray.tmin = 0, ray.tmax = INFINITY;
+    float t = s[3] * (1 + u(rng));
+    if (k % 9 == 0) ray.o = Vec3(s[0], s[1], s[2]), t = 0;  // the hit point is the centre
+    const int material = int(rng() % 3);
+    SurfaceHit fast, slow;
+    refine_sphere(s, material, ray, t, fast);
+    refine_sphere_scalar(s, material, ray, t, slow);
+    ASSERT_TRUE(same_record(fast, slow)) << "sphere " << k;
+    if (k % 9 == 0) ASSERT_EQ(slow.ng, Vec3(0, 1, 0));
+  }
 }
