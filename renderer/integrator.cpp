@@ -308,10 +308,8 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
   for (int j = 0; j < n; ++j) samplers[size_t(j)] = &rngs[slots[which[j]].job];
   // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
   // for all vertices at once: each sampler still sees its own draws in that order.
-  for (size_t l = 0; l < nl; ++l) {
-    Sampler::next_2d_many(samplers.data(), size_t(n), u.data(), params.simd_lanes);
-    for (int j = 0; j < n; ++j) u_light[size_t(j) * nl + l] = u[size_t(j)];
-  }
+  for (size_t l = 0; l < nl; ++l)  // light sample l of every vertex: u_light[l n, (l + 1) n)
+    Sampler::next_2d_many(samplers.data(), size_t(n), u_light.data() + l * size_t(n), params.simd_lanes);
   for (Sampler* rng : samplers) rng->skip_1d();
   Sampler::next_2d_many(samplers.data(), size_t(n), u.data(), params.simd_lanes);
   for (int j = 0; j < padded; ++j) {
@@ -339,7 +337,7 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
     const Light& light = scene.lights[l / size_t(params.light_samples)];
     if (is_black(light.color)) continue;
     for (int j = 0; j < padded; ++j) {
-      Vec2 u = u_light[size_t(j < n ? j : 0) * nl + l];
+      Vec2 u = u_light[l * size_t(n) + size_t(j < n ? j : 0)];
       v.ulx[j] = u.x, v.uly[j] = u.y;
       if (light.kind == LightKind::mesh) {
         Vec3 q, normal;
