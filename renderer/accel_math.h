@@ -5,10 +5,9 @@
 #pragma once
 
 #include <cmath>
-#include <utility>
-
 #include <cstddef>
 #include <cstring>
+#include <utility>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -165,6 +164,8 @@ struct TriangleInfo {
   int material;
   int light;      // -1 unless the triangle is an emitter registered as a light
 };
+static_assert(offsetof(TriangleInfo, material) == 12 && offsetof(TriangleInfo, light) == 16,
+              "TriangleInfo: refine_triangle loads ng with one 16-byte load and copies material and light together");
 
 // A triangle mesh as hit refinement reads it. Positions and normals hold 3 floats a vertex, and
 // each vertex must be readable with one 16-byte load (Embree pads its vertex buffers so; Accel
