@@ -1,9 +1,6 @@
 // bench_leave_out: samples/s of the specialised vs the generic path loop, and memory per primitive
 // of the shared render-scene base against the file's description.
 //   bench_leave_out [runs=3] [scene.dae ...]   (defaults: course scenes in ../shared and ours)
-#include <sys/stat.h>
-
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -11,11 +8,14 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.h"
 #include "collada.h"
 #include "progress.h"
 #include "render.h"
 
 using namespace pt;
+using bench::exists;
+using bench::median;  // the middle two averaged: for an even runs count it used to take the upper one
 
 namespace {
 
@@ -36,16 +36,6 @@ size_t desc_bytes(const SceneDesc& d) {
     b += sizeof(MeshDesc) + (m.positions.size() + m.normals.size()) * sizeof(Vec3) +
          m.indices.size() * sizeof(uint32_t) + m.tri_material.size() * sizeof(int);
   return b;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-bool exists(const std::string& p) {
-  struct stat st;
-  return stat(p.c_str(), &st) == 0;
 }
 
 const char* kUsage = "bench_leave_out [runs=3] [scene.dae ...]   (default scenes: the course's in ../shared and ours)";
