@@ -200,6 +200,7 @@ class RenderSession {
   bool render_all(const std::atomic<bool>* cancel = nullptr, const std::function<void()>& on_progress = {});
 
   const RenderParams& params() const { return m_params; }
+  const RenderScene& scene() const { return m_scene; }
   int width() const { return m_w; }
   int height() const { return m_h; }
   bool finished() const;
