@@ -225,8 +225,8 @@ int main(int argc, char** argv) {
   std::printf("\nWhere the time goes, one thread (AccelTimer, summed over the runs):\n%-10s %10s %10s %10s %12s %13s %9s\n",
               "scene", "PT Embree", "PT refine", "PT rest", "raw Embree", "Embree PT/raw", "rest/ray");
   for (const std::string& l : split) std::printf("%s\n", l.c_str());
-  std::printf("PT Embree / refine / rest = shares of the path tracer's pass: the Embree calls, the hit refinement after "
-              "packet intersections (Accel), everything else (sampling, shading, film, our checks around Embree); raw "
+  std::printf("PT Embree / refine / rest = shares of the path tracer's pass: the Embree calls, Accel's hit refinement "
+              "(after packet and single-ray intersections), everything else (sampling, shading, film, our checks around Embree); raw "
               "Embree = Embree's share of the replay PT/raw compares with (the rest packs the packets); Embree PT/raw = "
               "the Embree calls' time in the pass over their time in that replay (1: the same rays cost the same inside "
               "the path tracer); rest/ray = the path tracer's own time a ray, in %s\n",
