@@ -1,0 +1,263 @@
+// Render scene construction: the parameters' checks, the scene base built once per scene file
+// (materials, lights, Embree's BVH, feature bits, object bounds for the background mask) and the
+// per-render views of it (camera framing, environment map, caustic lights).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include "materials.h"
+#include "render.h"
+
+namespace pt {
+
+void RenderParams::validate() const {
+  auto bad = [](const std::string& field, const std::string& why) { throw std::invalid_argument(field + ": " + why); };
+  if (spp < 1 || spp > (1 << 24)) bad("spp (-s)", "must be between 1 and 16777216");
+  if (light_samples < 1 || light_samples > 65536) bad("light_samples (-l)", "must be between 1 and 65536");
+  if (max_depth < 0 || max_depth > 1000000) bad("max_depth (-m)", "must be between 0 and 1000000");
+  if (threads < 1 || threads > 1024) bad("threads (-t)", "must be between 1 and 1024");
+  if (!std::isfinite(lens_radius) || lens_radius < 0 || lens_radius > 1e6f) bad("lens_radius (-b)", "must be finite, >= 0 and <= 1e6");
+  if (!std::isfinite(focal_distance) || focal_distance < 0 || focal_distance > 1e12f)
+    bad("focal_distance (-d)", "must be finite and >= 0");
+  if (width < 1 || height < 1 || width > 16384 || height > 16384) bad("size (-r)", "width and height must be between 1 and 16384");
+  if (adaptive && (adaptive_batch < 1 || !std::isfinite(adaptive_tolerance) || adaptive_tolerance < 0))
+    bad("adaptive (-a)", "batch must be >= 1 and tolerance a finite number >= 0");
+  if (cell_w != 0 || cell_h != 0) {
+    if (cell_w < 1 || cell_h < 1 || cell_x < 0 || cell_y < 0 || cell_x + cell_w > width || cell_y + cell_h > height)
+      bad("cell (-p)", "x y dx dy must lie inside the " + std::to_string(width) + "x" + std::to_string(height) + " frame");
+  }
+  if (tile_size < 1 || tile_size > 4096) bad("tile_size", "must be between 1 and 4096");
+}
+
+CameraParams camera_params(const RenderParams& params) {
+  CameraParams cp;
+  cp.width = params.width;
+  cp.height = params.height;
+  cp.lens_radius = params.lens_radius;
+  cp.focal_distance = params.focal_distance;
+  cp.file_camera = params.file_camera;
+  cp.keep_fov = params.keep_fov;
+  cp.settings_file = params.camera_file;
+  return cp;
+}
+
+SceneBase make_scene_base(const SceneDesc& desc) {
+  SceneBase base;
+  base.materials = desc.materials;
+  std::vector<EmitterPanel> panels;
+  std::set<std::string> light_kinds;
+
+  for (const LightDesc& ld : desc.lights) {
+    Light l;
+    l.name = ld.name;
+    l.color = ld.color;
+    if (is_black(ld.color)) {
+      std::fprintf(stderr, "warning: %s: light '%s' has zero colour and is left out\n", desc.source.c_str(), ld.name.c_str());
+      continue;
+    }
+    switch (ld.type) {
+      case LightType::area: {
+        l.kind = LightKind::rect;
+        l.position = ld.position;
+        l.direction = ld.direction;
+        l.dim_x = ld.dim_x;
+        l.dim_y = ld.dim_y;
+        l.area = length(cross(ld.dim_x, ld.dim_y));
+        if (!(l.area > 0) || !std::isfinite(l.area)) {
+          std::fprintf(stderr, "warning: %s: area light '%s' has zero area and is left out\n", desc.source.c_str(), ld.name.c_str());
+          continue;
+        }
+        // The panel is visible to rays and emits on the side it faces.
+        EmitterPanel p;
+        Vec3 c = ld.position, hx = ld.dim_x * 0.5f, hy = ld.dim_y * 0.5f;
+        p.v[0] = c - hx - hy; p.v[1] = c + hx - hy; p.v[2] = c + hx + hy; p.v[3] = c - hx + hy;
+        if (dot(cross(ld.dim_x, ld.dim_y), ld.direction) < 0) std::swap(p.v[1], p.v[3]);
+        Material em;
+        em.name = ld.name + " (panel)";
+        em.type = MaterialType::emission;
+        em.radiance = ld.color;
+        p.material = int(base.materials.size());
+        base.materials.push_back(em);
+        p.light = int(base.lights.size());
+        panels.push_back(p);
+        break;
+      }
+      case LightType::point: l.kind = LightKind::point; l.position = ld.position; break;
+      case LightType::spot:
+        l.kind = LightKind::spot;
+        l.position = ld.position;
+        l.direction = ld.direction;
+        l.cos_cutoff = std::cos(std::min(ld.spot_angle_deg, 360.0f) * 0.5f * kPi / 180);
+        l.exponent = ld.spot_exponent;
+        break;
+      case LightType::directional: l.kind = LightKind::directional; l.direction = ld.direction; break;
+      case LightType::ambient: l.kind = LightKind::ambient; break;
+    }
+    light_kinds.insert(light_kind_name(l.kind));
+    base.lights.push_back(std::move(l));
+  }
+
+  // Emissive mesh triangles become one mesh light per (mesh, material), sampled by area.
+  std::vector<std::vector<int>> mesh_light(desc.meshes.size());
+  for (size_t mi = 0; mi < desc.meshes.size(); ++mi) {
+    const MeshDesc& mesh = desc.meshes[mi];
+    std::map<int, int> light_of_material;
+    for (size_t t = 0; t < mesh.tri_material.size(); ++t) {
+      int mat = mesh.tri_material[t];
+      if (!is_emissive(base.materials[mat])) continue;
+      const uint32_t* vi = &mesh.indices[3 * t];
+      if (!(length(cross(mesh.positions[vi[1]] - mesh.positions[vi[0]], mesh.positions[vi[2]] - mesh.positions[vi[0]])) > 0))
+        continue;  // a zero-area triangle cannot emit
+      auto it = light_of_material.find(mat);
+      if (it == light_of_material.end()) {
+        Light l;
+        l.kind = LightKind::mesh;
+        l.name = mesh.name;
+        l.color = base.materials[mat].radiance;
+        it = light_of_material.emplace(mat, int(base.lights.size())).first;
+        base.lights.push_back(std::move(l));
+      }
+      Light& l = base.lights[it->second];
+      for (int k = 0; k < 3; ++k) l.triangles.push_back(mesh.positions[mesh.indices[3 * t + k]]);
+      if (mesh_light[mi].empty()) mesh_light[mi].assign(mesh.tri_material.size(), -1);
+      mesh_light[mi][t] = it->second;
+    }
+  }
+  for (Light& l : base.lights) {
+    if (l.kind != LightKind::mesh) continue;
+    std::vector<float> areas(l.triangles.size() / 3);
+    double total = 0;
+    for (size_t t = 0; t < areas.size(); ++t) {
+      const Vec3* v = &l.triangles[3 * t];
+      areas[t] = 0.5f * length(cross(v[1] - v[0], v[2] - v[0]));
+      total += areas[t];
+    }
+    l.area = float(total);
+    l.triangle_distribution = Distribution1D(areas);
+    light_kinds.insert("mesh");
+  }
+
+  base.accel = std::make_shared<const Accel>(desc, panels, mesh_light);
+
+  SceneFeatures& f = base.features;
+  std::set<std::string> mats;
+  for (const MeshDesc& m : desc.meshes)
+    for (int t : m.tri_material) mats.insert(material_type_name(base.materials[t].type));
+  for (const SphereDesc& s : desc.spheres) mats.insert(material_type_name(base.materials[s.material].type));
+  if (!panels.empty()) mats.insert("emission");
+  f.materials.assign(mats.begin(), mats.end());
+  f.lights.assign(light_kinds.begin(), light_kinds.end());
+  f.spheres = !desc.spheres.empty();
+  f.meshes = !desc.meshes.empty();
+  for (const MeshDesc& m : desc.meshes) f.shading_normals |= !m.normals.empty();
+  f.bits = 0;
+  for (const Material& m : base.materials) {
+    if (is_delta(m)) f.bits |= kFeatDelta;
+    if (m.type == MaterialType::microfacet) f.bits |= kFeatMicrofacet;
+  }
+  for (const Light& l : base.lights)
+    if (l.kind == LightKind::ambient) f.bits |= kFeatInfinite;
+  base.triangle_count = desc.triangle_count();
+  base.sphere_count = desc.spheres.size();
+  base.camera = desc.camera;
+  base.bounds = desc.geometry_bounds();
+  base.caustic_targets = find_caustic_targets(desc, base.materials);
+  // Each object's box, padded as Accel pads the scene's (relative to the largest coordinate).
+  for (const MeshDesc& m : desc.meshes) {
+    Bounds3 b;
+    for (Vec3 p : m.positions) b.expand(p);
+    if (!b.empty()) base.object_bounds.push_back(b);
+  }
+  for (const SphereDesc& s : desc.spheres) {
+    Vec3 r(s.radius, s.radius, s.radius);
+    base.object_bounds.push_back({s.center - r, s.center + r});
+  }
+  for (const EmitterPanel& p : panels) {
+    Bounds3 b;
+    for (Vec3 v : p.v) b.expand(v);
+    base.object_bounds.push_back(b);
+  }
+  float size = 0;
+  for (const Bounds3& b : base.object_bounds)
+    size = std::max({size, max_component(abs(b.lo)), max_component(abs(b.hi)), max_component(b.hi - b.lo)});
+  const float pad = 1e-3f * size + 1e-6f;
+  for (Bounds3& b : base.object_bounds) b.lo = b.lo - Vec3(pad, pad, pad), b.hi = b.hi + Vec3(pad, pad, pad);
+  base.source = desc.source;
+  return base;
+}
+
+size_t SceneBase::memory_bytes() const {
+  size_t bytes = accel ? accel->memory_bytes() : 0;
+  bytes += materials.capacity() * sizeof(Material) + lights.capacity() * sizeof(Light);
+  bytes += object_bounds.capacity() * sizeof(Bounds3) + caustic_targets.capacity() * sizeof(CausticTarget);
+  for (const Light& l : lights)  // mesh lights: corners, and the area distribution (float + double cdf)
+    bytes += l.triangles.capacity() * sizeof(Vec3) + l.triangle_distribution.size() * (sizeof(float) + sizeof(double));
+  return bytes;
+}
+
+namespace {
+
+// A view from a base taken by value: make_render_scene moves its fresh base in, make_view copies.
+std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params) {
+  auto rs = std::make_unique<RenderScene>();
+  rs->materials = std::move(base.materials);
+  rs->lights = std::move(base.lights);
+  rs->accel = std::move(base.accel);
+  rs->triangle_count = base.triangle_count;
+  rs->sphere_count = base.sphere_count;
+  SceneFeatures& f = rs->features;
+  f = std::move(base.features);
+  if (!params.env_map.empty()) {
+    ImageRGB env = read_image(params.env_map);
+    auto map = std::make_shared<const EnvironmentMap>(env.width, env.height, std::move(env.pixels));
+    Light l;
+    l.kind = LightKind::environment;
+    l.name = params.env_map;
+    l.env = map.get();
+    rs->environment = std::move(map);
+    rs->environment_light = int(rs->lights.size());
+    rs->lights.push_back(std::move(l));
+    std::set<std::string> kinds(f.lights.begin(), f.lights.end());
+    kinds.insert("environment");
+    f.lights.assign(kinds.begin(), kinds.end());
+  }
+  for (size_t i = 0; i < rs->lights.size(); ++i)
+    if (rs->lights[i].kind == LightKind::ambient || rs->lights[i].kind == LightKind::environment)
+      rs->infinite_lights.push_back(int(i));
+  rs->camera = make_camera(base.camera, base.bounds, camera_params(params));
+  rs->caustic_targets = std::move(base.caustic_targets);
+  rs->object_bounds = std::move(base.object_bounds);
+  std::vector<float> power;
+  for (size_t i = 0; i < rs->lights.size(); ++i) {
+    const Light& l = rs->lights[i];
+    if (l.kind != LightKind::rect && l.kind != LightKind::mesh) continue;
+    rs->caustic_lights.push_back(int(i));
+    power.push_back(luminance(l.color) * l.area);
+  }
+  if (!power.empty()) rs->caustic_light_distribution = Distribution1D(power);
+
+  f.environment = rs->environment != nullptr;
+  f.thin_lens = params.lens_radius > 0;
+  f.adaptive = params.adaptive && params.spp > params.adaptive_batch;
+  f.caustic_tracing = caustic_tracing_applies(*rs, params);
+  if (!rs->infinite_lights.empty()) f.bits |= kFeatInfinite;
+  if (params.generic) f.bits = kFeatAll;
+  return rs;
+}
+
+}  // namespace
+
+std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams& params) {
+  params.validate();
+  return view_of(base, params);
+}
+
+std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
+  params.validate();  // before the build: a bad option fails fast
+  return view_of(make_scene_base(desc), params);
+}
+
+}  // namespace pt
