@@ -1,9 +1,9 @@
 // Paths in packets (render_tile_batched, trace_paths_t): many camera paths advance together and
-// their rays go to Embree in packets (16 rays, 8 without AVX-512). They must trace the paths the one-at-a-time loop traces:
-// the same random numbers, the same shadow-ray sums in the same order, the same per-pixel
-// statistics and adaptive stops. Embree's packet kernel may round a rare hit differently from its
-// single-ray kernel (about 5 in 100,000 rays in the last bit), which sends that one path another
-// way: a few pixels may differ, nothing else.
+// their rays go to Embree in packets (16 rays, 8 without AVX-512). They must trace the paths the
+// one-at-a-time loop traces: the same random numbers, the same shadow-ray sums in the same order,
+// the same per-pixel statistics and adaptive stops. Embree's packet kernel may round a rare hit
+// differently from its single-ray kernel (about 5 in 100,000 rays in the last bit), which sends
+// that one path another way: a few pixels may differ, nothing else.
 #include <gtest/gtest.h>
 
 #include "collada.h"
