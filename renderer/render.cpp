@@ -111,15 +111,19 @@ void RenderSession::find_scene_rectangle() {
   };
   m_scene_pixels = clipped(m_scene_u0, m_scene_u1, float(m_params.width)) * clipped(m_scene_v0, m_scene_v1, float(m_params.height));
   m_background_rect = m_scene.environment_light < 0;
-  if (!m_background_rect) return;
+  if (!m_background_rect || size_t(m_w) * m_h > (size_t(1) << 24)) return;
 
   // Within the rectangle, the pixels no object's own rectangle reaches (the sky above an open
-  // floor): a film mask, for a bounded number of objects and pixels.
+  // floor), for a bounded number of objects: `seen` is empty when the rectangle alone decides.
   const auto& objects = m_scene.object_bounds;
-  if (objects.empty() || objects.size() > kMaxMaskedObjects || size_t(m_w) * m_h > (size_t(1) << 24)) return;
-  std::vector<uint8_t> mask(size_t(m_w) * m_h, 0);
-  for (const Bounds3& b : objects) {
-    if (!project_box(cam, m_params.width, m_params.height, b.lo, b.hi, r)) return;  // no mask: the rectangle only
+  std::vector<uint8_t> seen;
+  if (!objects.empty() && objects.size() <= kMaxMaskedObjects) seen.assign(size_t(m_w) * m_h, 0);
+  for (size_t k = 0; k < objects.size() && !seen.empty(); ++k) {
+    const Bounds3& b = objects[k];
+    if (!project_box(cam, m_params.width, m_params.height, b.lo, b.hi, r)) {  // no mask: the rectangle only
+      seen.clear();
+      break;
+    }
     // Film pixels whose frame pixel [fx, fx + 1] x [fy, fy + 1] meets the rectangle grown by a pixel.
     auto px = [](float v, int size) { return int(std::clamp(v, -4.0f, float(size) + 4)); };
     int fx0 = px(std::floor(r[0] - 2), m_params.width), fx1 = px(std::ceil(r[1] + 1), m_params.width);
@@ -128,10 +132,16 @@ void RenderSession::find_scene_rectangle() {
     for (int fy_up = std::max(fy0, 0); fy_up <= std::min(fy1, m_params.height - 1); ++fy_up) {
       int y = (m_params.height - 1 - fy_up) - m_frame_y0;
       if (y < 0 || y >= m_h) continue;
-      for (int x = x0; x <= x1; ++x) mask[size_t(y) * m_w + x] = 1;
+      for (int x = x0; x <= x1; ++x) seen[size_t(y) * m_w + x] = 1;
     }
   }
-  m_seen = std::move(mask);
+  m_background.assign(size_t(m_w) * m_h, 0);
+  for (int y = 0; y < m_h; ++y)
+    for (int x = 0; x < m_w; ++x) {
+      const size_t i = size_t(y) * m_w + x;
+      const int fx = m_frame_x0 + x, fy_up = m_params.height - 1 - (m_frame_y0 + y);
+      m_background[i] = outside_scene_rectangle(fx, fy_up) || (!seen.empty() && !seen[i]);
+    }
 }
 
 // Light paths per sample and pixel of the area where the scene's bounds project (find_scene_rectangle),

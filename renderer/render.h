@@ -235,15 +235,24 @@ class RenderSession {
   // the scene, so that its samples are black without a ray query (see find_scene_rectangle).
   bool sees_only_background(int fx, int fy_up) const {
     if (!m_background_rect) return false;
-    if (fx + 1 < m_scene_u0 || fx > m_scene_u1 || fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1) return true;
     int x = fx - m_frame_x0, y = (m_params.height - 1 - fy_up) - m_frame_y0;
-    return !m_seen.empty() && x >= 0 && y >= 0 && x < m_w && y < m_h && !m_seen[size_t(y) * m_w + x];
+    if (!m_background.empty() && x >= 0 && y >= 0 && x < m_w && y < m_h) return m_background[size_t(y) * m_w + x];
+    return outside_scene_rectangle(fx, fy_up);
   }
   // Objects whose own projected rectangles refine the scene's (find_scene_rectangle).
   static constexpr size_t kMaxMaskedObjects = 256;
 
  private:
   void find_scene_rectangle();
+  bool outside_scene_rectangle(int fx, int fy_up) const {
+    return fx + 1 < m_scene_u0 || fx > m_scene_u1 || fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1;
+  }
+  // sees_only_background for film pixel i = y m_w + x, from the mask where there is one (the tile
+  // loops ask once per pixel and pass).
+  bool background_pixel(size_t i, int x, int y) const {
+    if (!m_background.empty()) return m_background[i] != 0;
+    return sees_only_background(m_frame_x0 + x, m_params.height - 1 - (m_frame_y0 + y));
+  }
   void trace_caustics(int target_spp, const std::atomic<bool>* cancel);
   uint64_t light_paths_for(uint64_t samples) const;
   Vec3 pixel_mean(size_t i) const;
@@ -268,7 +277,10 @@ class RenderSession {
   bool m_background_rect = false;
   float m_scene_u0 = 0, m_scene_u1 = 0, m_scene_v0 = 0, m_scene_v1 = 0;
   double m_scene_pixels = -1;  // the projected bounds' area within the full frame (-1: unknown)
-  std::vector<uint8_t> m_seen;  // film pixels some object's rectangle reaches (empty: no mask)
+  // Film pixels that see only background: outside the rectangle, or inside it where no object's
+  // own rectangle reaches. Empty without a rectangle, or for films over 2^24 pixels (the
+  // rectangle alone decides there).
+  std::vector<uint8_t> m_background;
   uint32_t m_first_sample = 0;
   std::vector<Tile> m_tiles;
   std::vector<Vec3> m_sum;

@@ -97,7 +97,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
       int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
       int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
       uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
-      const bool background = sees_only_background(fx, fy_up);
+      const bool background = background_pixel(i, x, y);
       uint32_t before = m_count[i];
       while (m_count[i] < uint32_t(target)) {
         uint32_t s = m_count[i];
@@ -205,16 +205,12 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
         size_t i = size_t(y) * m_w + x;
         uint32_t c = m_count[i];
         if (m_done[i] || c >= uint32_t(target)) continue;
-        int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
-        int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
-        uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
-        const bool background = sees_only_background(fx, fy_up);
         uint32_t end = uint32_t(target);
         if (p.adaptive) {  // up to the next stop test: after sample n with n > 1 and n - 1 a multiple of the batch
           uint32_t test = 1 + batch * ((std::max(c, 1u) + batch - 1) / batch);
           if (test < end) end = test, again = true;
         }
-        if (background) {  // zeros of its own: no job, no ray (but counted as the camera ray it would be)
+        if (background_pixel(i, x, y)) {  // zeros of its own: no job, no ray (but counted as the camera ray it would be)
           bool stop;
           uint32_t added = add_zero_samples(i, c, end, stop);
           rays += added;
@@ -225,6 +221,9 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
           }
           continue;
         }
+        const int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
+        const int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
+        const uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
         const uint32_t base = Sampler::pixel_base(p.seed, pixel_index);
         for (uint32_t s = c; s < end; ++s, ++njobs) {
           Job& job = jobs[njobs];  // fields stored one by one: a braced temporary is copied
