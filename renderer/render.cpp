@@ -4,6 +4,7 @@
 #include "render.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -361,7 +362,7 @@ void RenderSession::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const 
 
 double halves_error_estimate(int width, const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
                              const std::vector<double>& s1, const std::vector<double>& half_s1,
-                             const SplatStats& splats) {
+                             const SplatStats& splats, int threads) {
   // Relative MSE of the pixel means: mean over pixels of Var[mean] / (mu^2 + eps) (relMSE as in
   // Rousselle et al. 2011, eps keeping black pixels finite). Var[mean] comes from comparing the
   // mean A of samples [0, P) with the mean B of [P, n):
@@ -374,7 +375,8 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
   // of the true relMSE on CBspheres at m = 100 (docs/performance.md); always taking the median
   // overestimated small images with bright edges (1.6x on a 40x30 render).
   // One pass and no per-pixel array: a pixel's mean is computed where it is read, its neighbours'
-  // only for the rare firefly (the estimate runs between passes, on one thread).
+  // only for the rare firefly. It runs between passes, in blocks of pixels on the render's threads;
+  // the blocks' sums are added in block order, so the estimate does not depend on the thread count.
   const size_t n_pixels = count.size();
   const bool with_splats = splats.n > 0;
   const double splat_n = double(splats.n);
@@ -385,43 +387,59 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
   };
   const int w = std::max(1, width), h = int(n_pixels / size_t(w));
   const bool grid = h > 0 && size_t(w) * size_t(h) == n_pixels;
+  auto block = [&](size_t begin, size_t end, double& sum, size_t& used) {
+    for (size_t i = begin; i < end; ++i) {
+      uint32_t n = count[i], p = half_n[i];
+      if (n < 2 || p == 0 || p >= n) continue;
+      ++used;
+      if (s1[i] == 0 && half_s1[i] == 0 && !with_splats) continue;  // a black pixel adds exactly 0
+      double a = half_s1[i] / p, b = (s1[i] - half_s1[i]) / (n - p);
+      double var_mean = (a - b) * (a - b) * double(p) * double(n - p) / (double(n) * n);
+      if (with_splats) {
+        double sp = double(splats.half_n), t1 = (*splats.s1)[i];
+        if (sp > 0 && sp < splat_n) {
+          double sa = (*splats.half_s1)[i] / sp, sb = (t1 - (*splats.half_s1)[i]) / (splat_n - sp);
+          var_mean += (sa - sb) * (sa - sb) * sp * (splat_n - sp) / (splat_n * splat_n);
+        }
+      }
+      double mu = mean_at(i);
+      // A firefly: from one half only (a bright edge is in both), and far above its neighbours.
+      if (std::max(a, b) > 3 * std::min(a, b) && grid) {
+        int x = int(i % size_t(w)), y = int(i / size_t(w));
+        double v[9];
+        int k = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            v[k++] = mean_at(size_t(std::clamp(y + dy, 0, h - 1)) * size_t(w) + size_t(std::clamp(x + dx, 0, w - 1)));
+        std::nth_element(v, v + 4, v + 9);
+        if (mu > 3 * v[4]) mu = std::max(v[4], std::min(a, b));
+      }
+      sum += var_mean / (mu * mu + kRelMseEpsilon);
+    }
+  };
+  constexpr size_t kBlock = 1 << 14;  // pixels; starting a thread costs about what a few thousand do
+  const size_t blocks = (n_pixels + kBlock - 1) / kBlock;
+  std::vector<double> sums(blocks, 0.0);
+  std::vector<size_t> useds(blocks, 0);
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t b; (b = next.fetch_add(1)) < blocks;)
+      block(b * kBlock, std::min(n_pixels, (b + 1) * kBlock), sums[b], useds[b]);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::min<int>(threads, int(blocks)); ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
   double sum = 0;
   size_t used = 0;
-  for (size_t i = 0; i < n_pixels; ++i) {
-    uint32_t n = count[i], p = half_n[i];
-    if (n < 2 || p == 0 || p >= n) continue;
-    ++used;
-    if (s1[i] == 0 && half_s1[i] == 0 && !with_splats) continue;  // a black pixel adds exactly 0
-    double a = half_s1[i] / p, b = (s1[i] - half_s1[i]) / (n - p);
-    double var_mean = (a - b) * (a - b) * double(p) * double(n - p) / (double(n) * n);
-    if (with_splats) {
-      double sp = double(splats.half_n), t1 = (*splats.s1)[i];
-      if (sp > 0 && sp < splat_n) {
-        double sa = (*splats.half_s1)[i] / sp, sb = (t1 - (*splats.half_s1)[i]) / (splat_n - sp);
-        var_mean += (sa - sb) * (sa - sb) * sp * (splat_n - sp) / (splat_n * splat_n);
-      }
-    }
-    double mu = mean_at(i);
-    // A firefly: from one half only (a bright edge is in both), and far above its neighbours.
-    if (std::max(a, b) > 3 * std::min(a, b) && grid) {
-      int x = int(i % size_t(w)), y = int(i / size_t(w));
-      double v[9];
-      int k = 0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          v[k++] = mean_at(size_t(std::clamp(y + dy, 0, h - 1)) * size_t(w) + size_t(std::clamp(x + dx, 0, w - 1)));
-      std::nth_element(v, v + 4, v + 9);
-      if (mu > 3 * v[4]) mu = std::max(v[4], std::min(a, b));
-    }
-    sum += var_mean / (mu * mu + kRelMseEpsilon);
-  }
+  for (size_t b = 0; b < blocks; ++b) sum += sums[b], used += useds[b];
   return used ? sum / double(n_pixels) : INFINITY;
 }
 
 double RenderSession::error_estimate() const {
   // P, the first half's size, is the last power of two below n.
   return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
-                               {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths});
+                               {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths}, m_params.threads);
 }
 
 SessionStats RenderSession::stats() const {

@@ -161,7 +161,7 @@ struct SplatStats {
 };
 double halves_error_estimate(int width, const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
                              const std::vector<double>& s1, const std::vector<double>& half_s1,
-                             const SplatStats& splats = {});
+                             const SplatStats& splats = {}, int threads = 1);
 
 // A pixel's radiance: the mean of its camera samples plus, where caustics are light traced, its
 // splat sum over every light path traced (caustics.h). The session and the merged film both use it.

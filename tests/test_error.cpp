@@ -1,6 +1,9 @@
 // Error against run time: the reference-free error estimate tracks the true error.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+
 #include "collada.h"
 #include "render.h"
 #include "test_util.h"
@@ -102,6 +105,25 @@ TEST(ErrorEstimateDenominator, FireflyUsesItsNeighbourhoodBrightEdgeKeepsItsOwnM
   double edge = estimate_with_centre(9.8, 10.2);
   double edge_var = 0.4 * 0.4 * p * (n - p) / double(n * n);
   EXPECT_NEAR(edge - quiet, edge_var / (10.0 * 10.0 + kRelMseEpsilon) / (w * h) - quiet / (w * h), 1e-8);
+}
+
+// The estimate runs in blocks of pixels on the render's threads and adds the blocks' sums in
+// order: any thread count gives the same bits, on a film of several blocks with fireflies.
+TEST(ErrorEstimateThreads, TheSameBitsOnAnyThreadCount) {
+  const int w = 400, h = 300;
+  std::vector<uint32_t> count(w * h), half_n(w * h);
+  std::vector<double> s1(w * h), half(w * h);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < w * h; ++i) {
+    count[i] = 2 + rng() % 63;
+    half_n[i] = 1u << (31 - __builtin_clz(count[i] - 1));
+    half[i] = u(rng) * half_n[i];
+    s1[i] = half[i] + (u(rng) < 0.01 ? 50.0 : u(rng)) * (count[i] - half_n[i]);  // 1% fireflies
+  }
+  const double one = halves_error_estimate(w, count, half_n, s1, half, {}, 1);
+  EXPECT_TRUE(std::isfinite(one) && one > 0) << one;
+  for (int threads : {2, 3, 8}) EXPECT_EQ(halves_error_estimate(w, count, half_n, s1, half, {}, threads), one) << threads;
 }
 
 // Pixels that see only background add their samples as zeros in one step (add_zero_samples);
