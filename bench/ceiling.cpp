@@ -1,14 +1,15 @@
 // bench_ceiling: how fast Embree alone traces the rays our path tracer casts. Records every ray
 // of one 16-spp pass (record_rays_on_this_thread, renderer/accel.h), then replays the list in a
-// tight loop with 1 and 2 threads (the list split in halves) six ways: through Accel::intersect
-// / occluded (our wrapper, hit refinement included), through Accel::intersect_many / occluded_many
-// (the same in Embree packets of the CPU's native width, what the path tracer calls), raw
-// rtcIntersect1 / rtcOccluded1, Embree's stream API (rtcIntersect1M / rtcOccluded1M), and raw
-// packets of 16 (rtcIntersect16 / rtcOccluded16, as Mitsuba 3's LLVM variants trace on AVX-512)
-// and of 8 (rtcIntersect8 / rtcOccluded8). The path tracer's own rays/s on the same pass over
-// the replay's is the share of its time the ray queries would take if nothing else cost anything.
+// tight loop with 1 and N threads (N = 2 unless --threads says otherwise; the list split in N
+// parts) six ways: through Accel::intersect / occluded (our wrapper, hit refinement included),
+// through Accel::intersect_many / occluded_many (the same in Embree packets of the CPU's native
+// width, what the path tracer calls), raw rtcIntersect1 / rtcOccluded1, Embree's stream API
+// (rtcIntersect1M / rtcOccluded1M), and raw packets of 16 (rtcIntersect16 / rtcOccluded16, as
+// Mitsuba 3's LLVM variants trace on AVX-512) and of 8 (rtcIntersect8 / rtcOccluded8). The path
+// tracer's own rays/s on the same pass over the replay's is the share of its time the ray queries
+// would take if nothing else cost anything.
 //
-//   bench_ceiling [--spp 16] [--runs 5] [--scene NAME] [--sampler sobol|independent] [--smoke]
+//   bench_ceiling [--spp 16] [--runs 5] [--threads N] [--scene NAME] [--sampler sobol|independent] [--smoke]
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -27,7 +28,7 @@ using namespace bench;
 
 namespace {
 
-const char* kUsage = "bench_ceiling [--spp N=16] [--runs N=5] [--batch N=256] [--scene NAME] [--sampler sobol|independent] [--smoke]";
+const char* kUsage = "bench_ceiling [--spp N=16] [--runs N=5] [--threads N=2] [--batch N=256] [--scene NAME] [--sampler sobol|independent] [--smoke]";
 
 enum class Mode { accel, accel_many, raw, stream, packet16, packet8 };
 
@@ -90,7 +91,12 @@ int main(int argc, char** argv) {
   const size_t batch = size_t(std::max(2, args.integer("--batch", 256)));
   const std::string only = args.value("--scene", "");
   const SamplerKind sampler = args.sampler();
+  const int many = args.integer("--threads", 2);
   args.finish(kUsage);
+  if (many < 2 || many > 1024) {
+    std::fprintf(stderr, "bench_ceiling: --threads must be 2 to 1024, not %d\nusage: %s\n", many, kUsage);
+    return 2;
+  }
 
   std::vector<BenchScene> scenes = bench_scenes("bench_ceiling", smoke, only);
   std::printf("bench_ceiling: rays of one %d-spp pass at %s (keep_fov, m = 5, light_samples 1, no adaptive), "
@@ -138,7 +144,7 @@ int main(int argc, char** argv) {
     packet_width = accel.packet_width();
     for (Mode m : {Mode::accel, Mode::accel_many, Mode::raw, Mode::stream, Mode::packet16, Mode::packet8})
       replay_rate(accel, rec, 1, m, batch);  // warm up
-    for (int threads : {1, 2}) {
+    for (int threads : {1, many}) {
       std::vector<double> pt_rate, acc, acc_many, raw, stream, packet, packet8;
       // One thread renders and replays on this thread, where AccelTimer sees every Embree call.
       const bool timed = threads == 1;

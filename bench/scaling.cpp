@@ -1,7 +1,8 @@
-// bench_scaling: samples/s of the path tracer with 1 and 2 threads and their ratio, in the issue's
-// framing (480x360 keep_fov, light_samples 1, no adaptive sampling). Numbers only.
+// bench_scaling: samples/s of the path tracer with 1 and N threads (N = 2 unless --threads says
+// otherwise) and their ratio, in the framing (480x360 keep_fov, light_samples 1, no
+// adaptive sampling). Numbers only.
 //
-//   bench_scaling [--spp 16] [--runs 3] [--scene NAME] [--sampler sobol|independent] [--depth M] [--smoke]
+//   bench_scaling [--spp 16] [--runs 3] [--threads N] [--scene NAME] [--sampler sobol|independent] [--depth M] [--smoke]
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -16,7 +17,7 @@ using namespace pt;
 using namespace bench;
 
 namespace {
-const char* kUsage = "bench_scaling [--spp N=16] [--runs N=3] [--scene NAME] [--sampler sobol|independent] [--depth M] [--smoke]";
+const char* kUsage = "bench_scaling [--spp N=16] [--runs N=3] [--threads N=2] [--scene NAME] [--sampler sobol|independent] [--depth M] [--smoke]";
 }
 
 int main(int argc, char** argv) {
@@ -32,7 +33,12 @@ int main(int argc, char** argv) {
   const std::string only = args.value("--scene", "");
   const SamplerKind sampler = args.sampler();
   const int depth = args.integer("--depth", -1);  // overrides every scene's max depth
+  const int many = args.integer("--threads", 2);
   args.finish(kUsage);
+  if (many < 2 || many > 1024) {
+    std::fprintf(stderr, "bench_scaling: --threads must be 2 to 1024, not %d\nusage: %s\n", many, kUsage);
+    return 2;
+  }
 
   std::vector<BenchScene> scenes = bench_scenes("bench_scaling", smoke, only);
   std::printf("bench_scaling: one %d-spp pass at %s (keep_fov, light_samples 1, no adaptive, %s sampler), median of "
@@ -53,16 +59,16 @@ int main(int argc, char** argv) {
     for (int r = 0; r < runs; ++r)
       for (int t = 0; t < 2; ++t) {  // interleaved, so drift hits both alike
         RenderParams pt = p;
-        pt.threads = t + 1;
+        pt.threads = t == 0 ? 1 : many;
         RenderSession s(*scene, pt);
         s.render_pass(spp);
         sps[t].push_back(s.stats().samples / s.stats().seconds);
         rps[t].push_back(s.stats().rays / s.stats().seconds);
-        busy[t].push_back(s.stats().cpu_seconds / ((t + 1) * s.stats().seconds));
+        busy[t].push_back(s.stats().cpu_seconds / (pt.threads * s.stats().seconds));
         per_cpu[t].push_back(s.stats().samples / s.stats().cpu_seconds);
         bar.update(double(++done) / total);
       }
-    // Each run's 2-thread rate over the 1-thread rate just before it, then the median: pairs cancel
+    // Each run's N-thread rate over the 1-thread rate just before it, then the median: pairs cancel
     // the machine's slow drift, which a ratio of two medians does not; min-max shows the spread.
     std::vector<double> paired, paired_cpu;
     for (int r = 0; r < runs; ++r) {
@@ -77,12 +83,14 @@ int main(int argc, char** argv) {
     table.push_back(line);
   }
   bar.finish();
-  std::printf("%-10s %4s %12s %12s %7s %9s %12s %12s %8s %8s %9s\n", "scene", "m", "samples/s 1t", "samples/s 2t", "2t/1t",
-              "min-max", "rays/s 1t", "rays/s 2t", "busy 1t", "busy 2t", "per-CPU");
+  const std::string n = std::to_string(many) + "t";
+  std::printf("%-10s %4s %12s %12s %7s %9s %12s %12s %8s %8s %9s\n", "scene", "m", "samples/s 1t", ("samples/s " + n).c_str(),
+              (n + "/1t").c_str(), "min-max", "rays/s 1t", ("rays/s " + n).c_str(), "busy 1t", ("busy " + n).c_str(), "per-CPU");
   for (const std::string& l : table) std::printf("%s\n", l.c_str());
-  std::printf("2t/1t = median over runs of the 2-thread samples/s over the 1-thread samples/s of the same run "
+  std::printf("%s/1t = median over runs of the %d-thread samples/s over the 1-thread samples/s of the same run "
               "(min-max: the smallest and largest of those runs); busy = the render threads' CPU time over threads x wall "
               "time (below 1: threads waited for a core, or for each other at the pass's end); per-CPU = the same paired "
-              "ratio of samples per CPU-second (1.00: two threads do not slow each other down)\n");
+              "ratio of samples per CPU-second (1.00: the threads do not slow each other down)\n",
+              n.c_str(), many);
   return 0;
 }

@@ -98,6 +98,17 @@ TEST(BenchSmoke, Scaling) {
   EXPECT_GT(std::stod(m[3]), 0) << m.str();
 }
 
+// --threads N sets the second column's thread count: the header names it, and busy still lies in
+// (0, 1] with N threads on fewer cores, since busy divides by the threads asked for.
+TEST(BenchSmoke, ScalingThreadCount) {
+  std::string out;
+  ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --smoke --runs 1 --threads 3", out), 0) << out;
+  EXPECT_NE(out.find("samples/s 1t samples/s 3t   3t/1t   min-max"), std::string::npos) << out;
+  EXPECT_NE(out.find("busy 1t  busy 3t   per-CPU"), std::string::npos) << out;
+  EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --smoke --threads 1", out), 2) << out;
+  EXPECT_NE(out.find("--threads must be 2 to 1024"), std::string::npos) << out;
+}
+
 TEST(BenchSmoke, UnknownFlagIsRefused) {
   std::string out;
   EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --no-such-flag", out), 2) << out;
@@ -111,6 +122,12 @@ TEST(BenchSmoke, SceneMatchingNothingIsRefused) {
   EXPECT_NE(out.find("--scene 'no-such-scene' matches none of: "), std::string::npos) << out;
   EXPECT_NE(out.find("dof"), std::string::npos) << out;
   EXPECT_EQ(out.find("PT rays/s"), std::string::npos) << out;  // no table
+}
+
+TEST(BenchSmoke, CeilingThreadCountOutOfRangeIsRefused) {
+  std::string out;
+  EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_ceiling --threads 0", out), 2) << out;
+  EXPECT_NE(out.find("--threads must be 2 to 1024"), std::string::npos) << out;
 }
 
 // bench_leave_out takes positional arguments: --help prints them instead of running, a runs count
