@@ -173,6 +173,7 @@ TEST(Camera, SettingsFileRoundTrip) {
 TEST(Camera, BadSettingsFileNamesTheField) {
   std::string path = test::temp_dir() + "/cam_bad.txt";
   FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr) << path;
   std::fputs("30 20 1.5 0.1 100\n0 0 0 1 1 1\n1 2 oops\n", f);
   std::fclose(f);
   CameraParams p;

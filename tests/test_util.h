@@ -3,7 +3,7 @@
 #pragma once
 
 #include <gtest/gtest.h>
-#include <sys/stat.h>
+#include <filesystem>
 
 #include <cmath>
 #include <string>
@@ -37,9 +37,12 @@ inline std::string shared_scene(const std::string& name) {
 
 inline std::string own_scene(const std::string& name) { return std::string(PT_OWN_SCENES) + "/" + name; }
 
+// Made with its parents, so that a test binary run outside ctest (another checkout, another
+// machine) still has somewhere to write.
 inline std::string temp_dir() {
   std::string d = PT_TEST_TMP;
-  mkdir(d.c_str(), 0755);
+  std::error_code ec;
+  std::filesystem::create_directories(d, ec);
   return d;
 }
 
