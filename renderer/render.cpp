@@ -56,6 +56,21 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
   for (int y = 0; y < m_h; y += ts)
     for (int x = 0; x < m_w; x += ts) m_tiles.push_back({x, y, std::min(x + ts, m_w), std::min(y + ts, m_h)});
   find_scene_rectangle();
+  // Before any pass, a tile's cost is its pixels that see the scene.
+  m_tile_ns.assign(m_tiles.size(), 0);
+  for (size_t t = 0; t < m_tiles.size(); ++t) {
+    const Tile& tile = m_tiles[t];
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x) m_tile_ns[t] += !background_pixel(size_t(y) * m_w + x, x, y);
+  }
+  order_tiles_by_cost();
+}
+
+void RenderSession::order_tiles_by_cost() {
+  m_tile_order.resize(m_tiles.size());
+  for (size_t t = 0; t < m_tiles.size(); ++t) m_tile_order[t] = uint32_t(t);
+  std::stable_sort(m_tile_order.begin(), m_tile_order.end(),
+                   [&](uint32_t a, uint32_t b) { return m_tile_ns[a] > m_tile_ns[b]; });
 }
 
 // Where the scene's (padded) bounding box projects on the sensor of a camera in front of it. The
@@ -222,10 +237,13 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
     const uint64_t cpu_start = thread_cpu_ns();
     uint64_t rays = 0, samples = 0, nonfinite = 0;
     for (;;) {
-      size_t ti = next.fetch_add(1);
-      if (ti >= m_tiles.size()) break;
+      const size_t k = next.fetch_add(1);
+      if (k >= m_tile_order.size()) break;
       if (stop_requested(cancel)) break;
+      const uint32_t ti = m_tile_order[k];
+      const auto t0 = std::chrono::steady_clock::now();
       render_tile(m_tiles[ti], target_spp, cancel, rays, samples, nonfinite);
+      m_tile_ns[ti] = uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count());
       if (on_tile && !stop_requested(cancel)) on_tile(m_tiles[ti]);
     }
     m_rays += rays;
@@ -238,6 +256,7 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
   for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
   worker();
   for (auto& t : pool) t.join();
+  order_tiles_by_cost();
   m_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++m_passes;
   return !stop_requested(cancel);

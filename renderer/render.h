@@ -244,6 +244,7 @@ class RenderSession {
 
  private:
   void find_scene_rectangle();
+  void order_tiles_by_cost();  // m_tile_order from m_tile_ns, ties in raster order
   bool outside_scene_rectangle(int fx, int fy_up) const {
     return fx + 1 < m_scene_u0 || fx > m_scene_u1 || fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1;
   }
@@ -283,6 +284,12 @@ class RenderSession {
   std::vector<uint8_t> m_background;
   uint32_t m_first_sample = 0;
   std::vector<Tile> m_tiles;
+  // The order threads take tiles in: the costliest first (the last pass's time, at first the
+  // pixels that see the scene), so that the pass does not end waiting on one thread's last big
+  // tile (longest-processing-time-first; R. L. Graham, "Bounds on multiprocessing timing
+  // anomalies", SIAM J. Appl. Math. 17, 1969). The image does not depend on the order.
+  std::vector<uint32_t> m_tile_order;
+  std::vector<uint64_t> m_tile_ns;  // each tile's render time in the last pass that reached it
   std::vector<Vec3> m_sum;
   std::vector<double> m_s1, m_s2;   // luminance sums for adaptive sampling (the course's test)
   // The luminance sum at the last power-of-two sample count P below the current count n: the

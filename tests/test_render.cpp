@@ -5,6 +5,8 @@
 #include <cstring>
 #include <algorithm>
 #include <fstream>
+#include <mutex>
+#include <set>
 #include <sstream>
 
 #include "collada.h"
@@ -281,6 +283,49 @@ TEST(Stats, CpuSecondsCountEveryRenderThreadWithinTheWallTime) {
     const SessionStats two = s.stats();
     EXPECT_GT(two.cpu_seconds, one.cpu_seconds) << "passes add up, threads " << threads;
     EXPECT_LE(two.cpu_seconds, threads * two.seconds * 1.02 + 0.004) << threads;
+  }
+}
+
+// Threads take the costliest tiles first: before any pass, the tiles with the most pixels that see
+// the scene (in raster order among equals), so background-only tiles come last; every pass renders
+// every tile exactly once, whatever the order and thread count.
+TEST(Schedule, TilesThatSeeTheSceneComeFirst) {
+  SceneDesc d;
+  d.materials.resize(1);
+  d.spheres.push_back({"a", Vec3(-2, -1.5f, 0), 0.3f, 0});
+  d.spheres.push_back({"b", Vec3(2, 1.5f, 0), 0.3f, 0});
+  RenderParams p;
+  p.width = 96;
+  p.height = 72;
+  p.keep_fov = true;
+  p.tile_size = 8;
+  p.spp = 4;
+  for (int threads : {1, 3}) {
+    p.threads = threads;
+    auto scene = make_render_scene(d, p);
+    RenderSession s(*scene, p);
+    auto scene_pixels = [&](const Tile& t) {
+      int n = 0;
+      for (int y = t.y0; y < t.y1; ++y)
+        for (int x = t.x0; x < t.x1; ++x) n += !s.sees_only_background(x, p.height - 1 - y);
+      return n;
+    };
+    for (int pass = 1; pass <= 2; ++pass) {
+      std::mutex m;
+      std::vector<Tile> order;
+      s.render_pass(2 * pass, nullptr, [&](const Tile& t) {
+        std::lock_guard<std::mutex> lock(m);
+        order.push_back(t);
+      });
+      ASSERT_EQ(order.size(), s.tiles().size()) << "pass " << pass;
+      std::set<std::pair<int, int>> seen;
+      for (const Tile& t : order) EXPECT_TRUE(seen.insert({t.x0, t.y0}).second) << "tile twice: " << t.x0 << " " << t.y0;
+      if (pass > 1 || threads > 1) continue;  // later passes follow measured times; threads interleave
+      EXPECT_GT(scene_pixels(order.front()), 0);
+      EXPECT_EQ(scene_pixels(order.back()), 0) << "the spheres leave background-only tiles";
+      for (size_t k = 1; k < order.size(); ++k)
+        EXPECT_GE(scene_pixels(order[k - 1]), scene_pixels(order[k])) << "tile " << k;
+    }
   }
 }
 
