@@ -3,7 +3,6 @@
 #include "collada.h"
 
 #include <fstream>
-#include <functional>
 
 #include "collada_reader.h"
 
