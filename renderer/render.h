@@ -245,9 +245,9 @@ class RenderSession {
  private:
   void find_scene_rectangle();
   void order_tiles_by_cost();  // m_tile_order from m_tile_ns, ties in raster order
-  bool outside_scene_rectangle(int fx, int fy_up) const {
-    return fx + 1 < m_scene_u0 || fx > m_scene_u1 || fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1;
-  }
+  bool outside_scene_rectangle(int fx, int fy_up) const { return outside_scene_columns(fx) || outside_scene_rows(fy_up); }
+  bool outside_scene_columns(int fx) const { return fx + 1 < m_scene_u0 || fx > m_scene_u1; }
+  bool outside_scene_rows(int fy_up) const { return fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1; }
   // sees_only_background for film pixel i = y m_w + x, from the mask where there is one (the tile
   // loops ask once per pixel and pass).
   bool background_pixel(size_t i, int x, int y) const {
