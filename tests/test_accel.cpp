@@ -3,6 +3,7 @@
 // corners included) nor keep a miss from being one.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -440,4 +441,36 @@ TEST(Background, ThinLensSkipsOnlyPixelsNoLensPointSeesGeometryThrough) {
       if (radius > 0.1f && focus != 4.7f) EXPECT_LT(skipped, pinhole) << "a large blur must grow the rectangle";
       if (radius < 0.1f) EXPECT_GT(skipped, pinhole / 2) << "a small lens keeps most of the shortcut, focus " << focus;
     }
+}
+
+// A cell (-p) builds its own background mask for its window of the frame: every frame pixel in the
+// window must be background in the cell exactly when it is in the full frame (the mask's row and
+// column offsets and its y flip), for the scene rectangle alone and with objects' rectangles.
+TEST(Background, CellMasksAgreeWithTheFullFrame) {
+  SceneDesc spheres;
+  spheres.materials.resize(1);
+  spheres.spheres.push_back({"a", Vec3(-2, -1.5f, 0), 0.3f, 0});
+  spheres.spheres.push_back({"b", Vec3(2, 1.5f, 0), 0.3f, 0});
+  for (const SceneDesc& d : {two_shapes(Vec3(0, 0, 0)), spheres}) {
+    RenderParams p;
+    p.width = 120;
+    p.height = 90;
+    p.keep_fov = true;
+    auto scene = make_render_scene(d, p);
+    RenderSession full(*scene, p);
+    int background = 0;
+    for (int fy = 0; fy < p.height; ++fy)
+      for (int fx = 0; fx < p.width; ++fx) background += full.sees_only_background(fx, fy);
+    EXPECT_GT(background, p.width * p.height / 10);
+    EXPECT_LT(background, p.width * p.height);
+    for (auto [cx, cy, cw, ch] : {std::array<int, 4>{0, 0, 40, 30}, {37, 11, 53, 61}, {100, 70, 20, 20}, {0, 45, 120, 45}}) {
+      RenderParams c = p;
+      c.cell_x = cx, c.cell_y = cy, c.cell_w = cw, c.cell_h = ch;
+      RenderSession cell(*make_render_scene(d, c), c);
+      for (int fy = cy; fy < cy + ch; ++fy)
+        for (int fx = cx; fx < cx + cw; ++fx)
+          ASSERT_EQ(cell.sees_only_background(fx, fy), full.sees_only_background(fx, fy))
+              << "frame pixel " << fx << " " << fy << " in cell " << cx << " " << cy << " " << cw << " " << ch;
+    }
+  }
 }
