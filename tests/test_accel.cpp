@@ -13,6 +13,7 @@
 #include "accel.h"
 #include "collada.h"
 #include "render.h"
+#include "test_util.h"
 
 using namespace pt;
 
@@ -406,10 +407,7 @@ TEST(Background, SkippedPixelsSeeNoGeometry) {
 // Two small spheres far apart: the scene's rectangle holds both and the empty space between them;
 // the objects' own rectangles leave that space to the background shortcut.
 TEST(Background, ObjectRectanglesSkipTheEmptySpaceBetweenObjects) {
-  SceneDesc d;
-  d.materials.resize(1);
-  d.spheres.push_back({"a", Vec3(-2, -1.5f, 0), 0.3f, 0});
-  d.spheres.push_back({"b", Vec3(2, 1.5f, 0), 0.3f, 0});
+  SceneDesc d = test::two_small_spheres();
   for (float lens : {0.0f, 0.05f}) {
     RenderParams p;
     p.width = 120;
@@ -447,11 +445,7 @@ TEST(Background, ThinLensSkipsOnlyPixelsNoLensPointSeesGeometryThrough) {
 // window must be background in the cell exactly when it is in the full frame (the mask's row and
 // column offsets and its y flip), for the scene rectangle alone and with objects' rectangles.
 TEST(Background, CellMasksAgreeWithTheFullFrame) {
-  SceneDesc spheres;
-  spheres.materials.resize(1);
-  spheres.spheres.push_back({"a", Vec3(-2, -1.5f, 0), 0.3f, 0});
-  spheres.spheres.push_back({"b", Vec3(2, 1.5f, 0), 0.3f, 0});
-  for (const SceneDesc& d : {two_shapes(Vec3(0, 0, 0)), spheres}) {
+  for (const SceneDesc& d : {two_shapes(Vec3(0, 0, 0)), test::two_small_spheres()}) {
     RenderParams p;
     p.width = 120;
     p.height = 90;

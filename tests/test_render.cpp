@@ -290,10 +290,7 @@ TEST(Stats, CpuSecondsCountEveryRenderThreadWithinTheWallTime) {
 // the scene (in raster order among equals), so background-only tiles come last; every pass renders
 // every tile exactly once, whatever the order and thread count.
 TEST(Schedule, TilesThatSeeTheSceneComeFirst) {
-  SceneDesc d;
-  d.materials.resize(1);
-  d.spheres.push_back({"a", Vec3(-2, -1.5f, 0), 0.3f, 0});
-  d.spheres.push_back({"b", Vec3(2, 1.5f, 0), 0.3f, 0});
+  SceneDesc d = test::two_small_spheres();
   RenderParams p;
   p.width = 96;
   p.height = 72;

@@ -35,6 +35,16 @@ inline std::string shared_scene(const std::string& name) {
   std::string var = ::pt::test::shared_scene(name);                             \
   if (var.empty()) GTEST_SKIP() << "../shared/scenes-cs184/" << name << " is absent"
 
+// Two small spheres far apart on a diagonal, no light: most of the course framing is background,
+// including the space between them (the background mask and tile order tests).
+inline SceneDesc two_small_spheres() {
+  SceneDesc d;
+  d.materials.resize(1);
+  d.spheres.push_back({"a", Vec3(-2, -1.5f, 0), 0.3f, 0});
+  d.spheres.push_back({"b", Vec3(2, 1.5f, 0), 0.3f, 0});
+  return d;
+}
+
 inline std::string own_scene(const std::string& name) { return std::string(PT_OWN_SCENES) + "/" + name; }
 
 // Made with its parents, so that a test binary run outside ctest (another checkout, another
