@@ -98,8 +98,8 @@ TEST(BenchSmoke, Scaling) {
   EXPECT_GT(std::stod(m[3]), 0) << m.str();
 }
 
-// --threads N sets the second column's thread count: the header names it, and busy still lies in
-// (0, 1] with N threads on fewer cores, since busy divides by the threads asked for.
+// --threads N sets the second column's thread count, which the header names; fewer than 2 is an
+// error that says so.
 TEST(BenchSmoke, ScalingThreadCount) {
   std::string out;
   ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --smoke --runs 1 --threads 3", out), 0) << out;
