@@ -1,5 +1,5 @@
 // What the error-vs-time benchmarks (convergence, ceiling, scaling) share: the scene list, the
-// render settings of the comparison framing, flags, medians.
+// render settings of the comparison framing, medians (flags: args.h).
 #pragma once
 
 #include <sys/stat.h>
@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "args.h"
 #include "render.h"
 
 namespace bench {
@@ -83,44 +84,5 @@ inline double median(std::vector<double> v) {
   size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
-
-// Minimal flag reading: `--name value` and `--name` switches; unknown flags end the program.
-struct Args {
-  int argc;
-  char** argv;
-  std::vector<bool> used;
-  Args(int c, char** v) : argc(c), argv(v), used(size_t(c), false) {}
-  bool flag(const char* name) {
-    for (int i = 1; i < argc; ++i)
-      if (!std::strcmp(argv[i], name)) return used[size_t(i)] = true;
-    return false;
-  }
-  std::string value(const char* name, const std::string& def) {
-    for (int i = 1; i + 1 < argc; ++i)
-      if (!std::strcmp(argv[i], name)) {
-        used[size_t(i)] = used[size_t(i) + 1] = true;
-        return argv[i + 1];
-      }
-    return def;
-  }
-  int integer(const char* name, int def) { return std::atoi(value(name, std::to_string(def)).c_str()); }
-  // --sampler sobol|independent (default: the renderer's default); exits 2 on anything else.
-  pt::SamplerKind sampler() {
-    std::string v = value("--sampler", "default");
-    if (v == "default") return pt::RenderParams().sampler;
-    if (v == "sobol") return pt::SamplerKind::sobol;
-    if (v == "independent") return pt::SamplerKind::independent;
-    std::fprintf(stderr, "%s: --sampler must be sobol or independent, not '%s'\n", argv[0], v.c_str());
-    std::exit(2);
-  }
-  // Call after reading every flag: exits 2 naming the first one not understood.
-  void finish(const char* usage) {
-    for (int i = 1; i < argc; ++i)
-      if (!used[size_t(i)]) {
-        std::fprintf(stderr, "%s: unknown argument '%s'\nusage: %s\n", argv[0], argv[i], usage);
-        std::exit(2);
-      }
-  }
-};
 
 }  // namespace bench

@@ -78,25 +78,21 @@ double replay_rate(const Accel& a, const RayRecorder& rec, int threads, Mode mod
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int bench_main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, also into a file
-  Args args(argc, argv);
+  Args args(argc, argv, kUsage);
   if (args.flag("--help") || args.flag("-h")) {
     std::printf("usage: %s\n", kUsage);
     return 0;
   }
   const bool smoke = args.flag("--smoke");
-  const int spp = args.integer("--spp", smoke ? 2 : 16);
-  const int runs = std::max(1, args.integer("--runs", smoke ? 1 : 5));
-  const size_t batch = size_t(std::max(2, args.integer("--batch", 256)));
+  const int spp = args.integer("--spp", smoke ? 2 : 16, 1, 1 << 24);
+  const int runs = args.integer("--runs", smoke ? 1 : 5, 1, 1000);
+  const size_t batch = size_t(args.integer("--batch", 256, 2, 1 << 20));
   const std::string only = args.value("--scene", "");
   const SamplerKind sampler = args.sampler();
-  const int many = args.integer("--threads", 2);
-  args.finish(kUsage);
-  if (many < 2 || many > 1024) {
-    std::fprintf(stderr, "bench_ceiling: --threads must be 2 to 1024, not %d\nusage: %s\n", many, kUsage);
-    return 2;
-  }
+  const int many = args.integer("--threads", 2, 2, 1024);
+  args.finish();
 
   std::vector<BenchScene> scenes = bench_scenes("bench_ceiling", smoke, only);
   std::printf("bench_ceiling: rays of one %d-spp pass at %s (keep_fov, m = 5, light_samples 1, no adaptive), "
@@ -243,3 +239,5 @@ int main(int argc, char** argv) {
 #endif
   return 0;
 }
+
+int main(int argc, char** argv) { return run_guarded("bench_ceiling", [&] { return bench_main(argc, argv); }); }

@@ -103,28 +103,24 @@ struct PassRow {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int bench_main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, also into a file
-  Args args(argc, argv);
+  Args args(argc, argv, kUsage);
   if (args.flag("--help") || args.flag("-h")) {
     std::printf("usage: %s\n", kUsage);
     return 0;
   }
   const bool smoke = args.flag("--smoke");
-  const int spp = args.integer("--spp", smoke ? 4 : 256);
-  const int ref_spp = args.integer("--ref-spp", smoke ? 16 : 1024);
-  const int runs = std::max(1, args.integer("--runs", smoke ? 1 : 3));
+  const int spp = args.integer("--spp", smoke ? 4 : 256, 1, 1 << 24);
+  const int ref_spp = args.integer("--ref-spp", smoke ? 16 : 1024, 1, 1 << 24);
+  const int runs = args.integer("--runs", smoke ? 1 : 3, 1, 1000);
   const std::string only = args.value("--scene", "");
   const SamplerKind sampler = args.sampler();
-  const int depth = args.integer("--depth", -1);  // overrides every scene's max depth
+  const int depth = args.integer("--depth", -1, -1, 1000000);  // overrides every scene's max depth
   const std::string out_dir = args.value("--out", std::string(PT_BINARY_DIR) + "/bench-results");
   const std::string cache = args.value("--cache", std::string(PT_BINARY_DIR) + "/bench-cache");
   const bool rebuild = args.flag("--rebuild-ref");
-  args.finish(kUsage);
-  if (spp < 1 || ref_spp < 1) {
-    std::fprintf(stderr, "bench_convergence: --spp and --ref-spp must be >= 1\n");
-    return 2;
-  }
+  args.finish();
 
   std::vector<BenchScene> scenes = bench_scenes("bench_convergence", smoke, only);
   make_dirs(out_dir);
@@ -228,3 +224,5 @@ int main(int argc, char** argv) {
   std::printf("efficiency = 1 / (true relMSE x seconds), the reference's noise not subtracted\n");
   return 0;
 }
+
+int main(int argc, char** argv) { return run_guarded("bench_convergence", [&] { return bench_main(argc, argv); }); }

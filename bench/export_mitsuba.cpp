@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench_common.h"
+#include "args.h"
 #include "camera.h"
 #include "collada.h"
 
@@ -51,16 +51,14 @@ json material_json(const pt::Material& m) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: %s scene.dae OUT_DIR [--width W --height H]\n", argv[0]);
-    return 2;
-  }
+  bench::Args args(argc, argv, "bench_export_mitsuba scene.dae OUT_DIR [--width W=480 --height H=360]");
+  const int width = args.integer("--width", 480, 1, 16384), height = args.integer("--height", 360, 1, 16384);
+  const std::vector<std::string> files = args.positional();
+  args.finish();
+  if (files.size() != 2) args.fail("needs a scene file and an output folder");
   try {
-    bench::Args args(argc, argv);
-    int width = args.integer("--width", 480), height = args.integer("--height", 360);
-    std::string scene_path = argv[1], out_dir = argv[2];
-    args.used[1] = args.used[2] = true;
-    args.finish("scene.dae OUT_DIR [--width W --height H]");
+    const std::string& scene_path = files[0];
+    const std::string& out_dir = files[1];
     pt::SceneDesc desc = pt::load_collada(scene_path);
 
     json scene;

@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "args.h"
 #include "film.h"
 
 namespace {
@@ -48,14 +49,9 @@ pt::FilmPass synthetic_pass(int w, int h, uint32_t first, uint32_t count, std::m
 }  // namespace
 
 int main(int argc, char** argv) {
-  int passes = 9;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--passes") && i + 1 < argc) passes = std::max(1, std::atoi(argv[++i]));
-    else {
-      std::fprintf(stderr, "usage: %s [--passes N]\n", argv[0]);
-      return 2;
-    }
-  }
+  bench::Args args(argc, argv, "bench_film_merge [--passes N=9]");
+  const int passes = args.integer("--passes", 9, 1, 1000);
+  args.finish();
   struct Size { int w, h; };
   std::printf("frame        MB/pass  encode ms  decode ms  merge ms  tiles ms  server ms/pass (decode+merge+tiles)\n");
   for (Size s : {Size{240, 180}, Size{480, 360}, Size{800, 600}, Size{1920, 1080}}) {

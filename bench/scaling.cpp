@@ -20,25 +20,21 @@ namespace {
 const char* kUsage = "bench_scaling [--spp N=16] [--runs N=3] [--threads N=2] [--scene NAME] [--sampler sobol|independent] [--depth M] [--smoke]";
 }
 
-int main(int argc, char** argv) {
+int bench_main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, also into a file
-  Args args(argc, argv);
+  Args args(argc, argv, kUsage);
   if (args.flag("--help") || args.flag("-h")) {
     std::printf("usage: %s\n", kUsage);
     return 0;
   }
   const bool smoke = args.flag("--smoke");
-  const int spp = args.integer("--spp", smoke ? 2 : 16);
-  const int runs = std::max(1, args.integer("--runs", smoke ? 1 : 3));
+  const int spp = args.integer("--spp", smoke ? 2 : 16, 1, 1 << 24);
+  const int runs = args.integer("--runs", smoke ? 1 : 3, 1, 1000);
   const std::string only = args.value("--scene", "");
   const SamplerKind sampler = args.sampler();
-  const int depth = args.integer("--depth", -1);  // overrides every scene's max depth
-  const int many = args.integer("--threads", 2);
-  args.finish(kUsage);
-  if (many < 2 || many > 1024) {
-    std::fprintf(stderr, "bench_scaling: --threads must be 2 to 1024, not %d\nusage: %s\n", many, kUsage);
-    return 2;
-  }
+  const int depth = args.integer("--depth", -1, -1, 1000000);  // overrides every scene's max depth
+  const int many = args.integer("--threads", 2, 2, 1024);
+  args.finish();
 
   std::vector<BenchScene> scenes = bench_scenes("bench_scaling", smoke, only);
   std::printf("bench_scaling: one %d-spp pass at %s (keep_fov, light_samples 1, no adaptive, %s sampler), median of "
@@ -94,3 +90,5 @@ int main(int argc, char** argv) {
               n.c_str(), many);
   return 0;
 }
+
+int main(int argc, char** argv) { return run_guarded("bench_scaling", [&] { return bench_main(argc, argv); }); }

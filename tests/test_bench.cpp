@@ -5,8 +5,10 @@
 
 #include <cstdio>
 #include <regex>
+#include <stdexcept>
 #include <string>
 
+#include "../bench/args.h"
 #include "test_util.h"
 
 namespace {
@@ -106,7 +108,7 @@ TEST(BenchSmoke, ScalingThreadCount) {
   EXPECT_NE(out.find("samples/s 1t samples/s 3t   3t/1t   min-max"), std::string::npos) << out;
   EXPECT_NE(out.find("busy 1t  busy 3t   per-CPU"), std::string::npos) << out;
   EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --smoke --threads 1", out), 2) << out;
-  EXPECT_NE(out.find("--threads must be 2 to 1024"), std::string::npos) << out;
+  EXPECT_NE(out.find("--threads must be a whole number from 2 to 1024, not '1'"), std::string::npos) << out;
 }
 
 TEST(BenchSmoke, UnknownFlagIsRefused) {
@@ -127,7 +129,47 @@ TEST(BenchSmoke, SceneMatchingNothingIsRefused) {
 TEST(BenchSmoke, CeilingThreadCountOutOfRangeIsRefused) {
   std::string out;
   EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_ceiling --threads 0", out), 2) << out;
-  EXPECT_NE(out.find("--threads must be 2 to 1024"), std::string::npos) << out;
+  EXPECT_NE(out.find("--threads must be a whole number from 2 to 1024, not '0'"), std::string::npos) << out;
+}
+
+// A count that is not a whole number in range, or a flag without its value, is refused by name
+// before anything runs: not read as 0 (atoi), not clamped, and not an abort from the renderer's
+// own check of the same setting.
+TEST(BenchSmoke, NumbersAreCheckedAndNamed) {
+  struct Case {
+    const char* command;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"bench_ceiling --smoke --spp 0", "bench_ceiling: --spp must be a whole number from 1 to 16777216, not '0'"},
+      {"bench_scaling --smoke --spp 4x", "bench_scaling: --spp must be a whole number from 1 to 16777216, not '4x'"},
+      {"bench_scaling --smoke --runs many", "bench_scaling: --runs must be a whole number from 1 to 1000, not 'many'"},
+      {"bench_convergence --smoke --depth -2", "bench_convergence: --depth must be a whole number from -1 to 1000000, not '-2'"},
+      {"bench_convergence --smoke --ref-spp 99999999999",
+       "bench_convergence: --ref-spp must be a whole number from 1 to 16777216, not '99999999999'"},
+      {"bench_ceiling --smoke --batch", "bench_ceiling: --batch needs a value"},
+      {"bench_film_merge --passes 0", "bench_film_merge: --passes must be a whole number from 1 to 1000, not '0'"},
+      {"bench_export_mitsuba --width 0 scene.dae out", "bench_export_mitsuba: --width must be a whole number from 1 to 16384"},
+      {"bench_export_mitsuba scene.dae", "bench_export_mitsuba: needs a scene file and an output folder"},
+  };
+  for (const Case& c : cases) {
+    std::string out;
+    EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/" + c.command, out), 2) << c.command << "\n" << out;
+    EXPECT_NE(out.find(c.message), std::string::npos) << c.command << "\n" << out;
+    EXPECT_NE(out.find("usage: "), std::string::npos) << c.command << "\n" << out;
+    EXPECT_EQ(out.find("terminate called"), std::string::npos) << c.command << "\n" << out;
+  }
+}
+
+// An exception inside a benchmark (a scene that does not load, a setting the renderer refuses)
+// becomes its message and status 1.
+TEST(BenchArgs, ExceptionsEndTheRunWithTheirMessage) {
+  testing::internal::CaptureStderr();
+  const int rc = bench::run_guarded("bench_x", []() -> int { throw std::invalid_argument("spp (-s): must be between 1 and 16777216"); });
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(err, "bench_x: spp (-s): must be between 1 and 16777216\n");
+  EXPECT_EQ(bench::run_guarded("bench_x", [] { return 0; }), 0);
 }
 
 // bench_leave_out takes positional arguments: --help prints them instead of running, a runs count
