@@ -30,6 +30,12 @@ struct Args {
     std::fprintf(stderr, "%s: %s\nusage: %s\n", prog.c_str(), what.c_str(), usage);
     std::exit(2);
   }
+  // --help or -h: prints the usage line; the caller then returns 0.
+  bool help() {
+    if (!flag("--help") && !flag("-h")) return false;
+    std::printf("usage: %s\n", usage);
+    return true;
+  }
   bool flag(const char* name) {
     for (int i = 1; i < argc; ++i)
       if (!std::strcmp(argv[i], name)) return used[size_t(i)] = true;

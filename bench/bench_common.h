@@ -76,6 +76,23 @@ inline pt::RenderParams bench_params(const BenchScene& s, bool smoke) {
   return p;
 }
 
+// The flags the error-vs-time benchmarks share; each default differs in smoke mode (dof.dae, 64x48).
+struct CommonFlags {
+  bool smoke;
+  int spp, runs;
+  std::string only;  // --scene
+  pt::SamplerKind sampler;
+};
+inline CommonFlags common_flags(Args& args, int spp, int smoke_spp, int runs) {
+  CommonFlags f;
+  f.smoke = args.flag("--smoke");
+  f.spp = args.integer("--spp", f.smoke ? smoke_spp : spp, 1, 1 << 24);
+  f.runs = args.integer("--runs", f.smoke ? 1 : runs, 1, 1000);
+  f.only = args.value("--scene", "");
+  f.sampler = args.sampler();
+  return f;
+}
+
 inline const char* sampler_name(pt::SamplerKind k) { return k == pt::SamplerKind::sobol ? "sobol" : "independent"; }
 
 inline double median(std::vector<double> v) {

@@ -81,16 +81,9 @@ double replay_rate(const Accel& a, const RayRecorder& rec, int threads, Mode mod
 int bench_main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, also into a file
   Args args(argc, argv, kUsage);
-  if (args.flag("--help") || args.flag("-h")) {
-    std::printf("usage: %s\n", kUsage);
-    return 0;
-  }
-  const bool smoke = args.flag("--smoke");
-  const int spp = args.integer("--spp", smoke ? 2 : 16, 1, 1 << 24);
-  const int runs = args.integer("--runs", smoke ? 1 : 5, 1, 1000);
+  if (args.help()) return 0;
+  const auto [smoke, spp, runs, only, sampler] = common_flags(args, 16, 2, 5);
   const size_t batch = size_t(args.integer("--batch", 256, 2, 1 << 20));
-  const std::string only = args.value("--scene", "");
-  const SamplerKind sampler = args.sampler();
   const int many = args.integer("--threads", 2, 2, 1024);
   args.finish();
 

@@ -106,16 +106,9 @@ struct PassRow {
 int bench_main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, also into a file
   Args args(argc, argv, kUsage);
-  if (args.flag("--help") || args.flag("-h")) {
-    std::printf("usage: %s\n", kUsage);
-    return 0;
-  }
-  const bool smoke = args.flag("--smoke");
-  const int spp = args.integer("--spp", smoke ? 4 : 256, 1, 1 << 24);
+  if (args.help()) return 0;
+  const auto [smoke, spp, runs, only, sampler] = common_flags(args, 256, 4, 3);
   const int ref_spp = args.integer("--ref-spp", smoke ? 16 : 1024, 1, 1 << 24);
-  const int runs = args.integer("--runs", smoke ? 1 : 3, 1, 1000);
-  const std::string only = args.value("--scene", "");
-  const SamplerKind sampler = args.sampler();
   const int depth = args.integer("--depth", -1, -1, 1000000);  // overrides every scene's max depth
   const std::string out_dir = args.value("--out", std::string(PT_BINARY_DIR) + "/bench-results");
   const std::string cache = args.value("--cache", std::string(PT_BINARY_DIR) + "/bench-cache");

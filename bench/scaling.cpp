@@ -23,15 +23,8 @@ const char* kUsage = "bench_scaling [--spp N=16] [--runs N=3] [--threads N=2] [-
 int bench_main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, also into a file
   Args args(argc, argv, kUsage);
-  if (args.flag("--help") || args.flag("-h")) {
-    std::printf("usage: %s\n", kUsage);
-    return 0;
-  }
-  const bool smoke = args.flag("--smoke");
-  const int spp = args.integer("--spp", smoke ? 2 : 16, 1, 1 << 24);
-  const int runs = args.integer("--runs", smoke ? 1 : 3, 1, 1000);
-  const std::string only = args.value("--scene", "");
-  const SamplerKind sampler = args.sampler();
+  if (args.help()) return 0;
+  const auto [smoke, spp, runs, only, sampler] = common_flags(args, 16, 2, 3);
   const int depth = args.integer("--depth", -1, -1, 1000000);  // overrides every scene's max depth
   const int many = args.integer("--threads", 2, 2, 1024);
   args.finish();
