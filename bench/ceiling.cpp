@@ -196,24 +196,25 @@ int bench_main(int argc, char** argv) {
       }
       // The spread of the paired ratios: on a noisy host the median alone hides how close it is.
       const auto [lo, hi] = std::minmax_element(paired.begin(), paired.end());
+      const auto [raw_lo, raw_hi] = std::minmax_element(paired_raw.begin(), paired_raw.end());
       char line[512];
       std::snprintf(line, sizeof line,
-                    "%-10s %7d %8.2f M %7.1f%% %9.2f %9.2f M %10.2f M %10.2f M %10.2f %4.2f-%4.2f %7.2f %9.2f M %11.2f M %11.2f M %11.2f M",
+                    "%-10s %7d %8.2f M %7.1f%% %9.2f %9.2f M %10.2f M %10.2f M %10.2f %4.2f-%4.2f %7.2f %4.2f-%4.2f %9.2f M %11.2f M %11.2f M %11.2f M",
                     sc.name.c_str(), threads, rec.rays.size() / 1e6, 100.0 * shadows / std::max<size_t>(1, rec.rays.size()),
                     double(pt_rays) / std::max<uint64_t>(1, pt_samples), median(pt_rate) / 1e6, median(acc) / 1e6,
-                    median(acc_many) / 1e6, median(paired), *lo, *hi, median(paired_raw), median(raw) / 1e6, median(stream) / 1e6,
+                    median(acc_many) / 1e6, median(paired), *lo, *hi, median(paired_raw), *raw_lo, *raw_hi, median(raw) / 1e6, median(stream) / 1e6,
                     median(packet) / 1e6, median(packet8) / 1e6);
       table.push_back(line);
     }
   }
   bar.finish();
-  std::printf("%-10s %7s %10s %8s %9s %11s %12s %12s %10s %9s %7s %11s %13s %13s %14s\n", "scene", "threads", "rays", "shadow",
-              "rays/spl", "PT rays/s", "replay 1", "replay many", "PT/replay", "min-max", "PT/raw", "raw 1 rays/s",
+  std::printf("%-10s %7s %10s %8s %9s %11s %12s %12s %10s %9s %7s %9s %11s %13s %13s %14s\n", "scene", "threads", "rays", "shadow",
+              "rays/spl", "PT rays/s", "replay 1", "replay many", "PT/replay", "min-max", "PT/raw", "min-max", "raw 1 rays/s",
               "stream rays/s", "packet16 rays/s", "packet8 rays/s");
   for (const std::string& l : table) std::printf("%s\n", l.c_str());
   std::printf("PT = the path tracer's rays/s on the same pass (rays that reach Accel), %s; replay 1 = Accel::intersect / "
               "occluded; replay many = Accel::intersect_many / occluded_many (packets of %d); PT/replay = median over runs of PT over the "
-              "replay that traces as the path tracer does, in the same run (min-max: the smallest and largest of those runs); PT/raw = the same median over Embree called directly the way the path tracer calls it (packets of %d, no checks, no hit refinement); raw 1 = rtcIntersect1 / rtcOccluded1; stream = "
+              "replay that traces as the path tracer does, in the same run (min-max: the smallest and largest of those runs); PT/raw = the same median (and min-max) over Embree called directly the way the path tracer calls it (packets of %d, no checks, no hit refinement); raw 1 = rtcIntersect1 / rtcOccluded1; stream = "
               "rtcIntersect1M / rtcOccluded1M, %zu rays a call; packet16 / packet8 = rtcIntersect16 / rtcOccluded16 and "
               "rtcIntersect8 / rtcOccluded8\n",
               RenderParams().ray_packets ? "in Embree packets" : "one ray at a time", packet_width, packet_width, batch);

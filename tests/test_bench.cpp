@@ -59,14 +59,8 @@ TEST(BenchSmoke, Convergence) {
 TEST(BenchSmoke, Ceiling) {
   std::string out;
   ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_ceiling --smoke --runs 3", out), 0) << out;
-  EXPECT_NE(out.find("replay 1  replay many  PT/replay   min-max  PT/raw"), std::string::npos) << out;
-  expect_median_within_spread(out, 2);  // one row per thread count
-  // PT/raw, after the min-max: a positive ratio in each row.
-  std::regex raw_ratio(R"( \d+\.\d\d-\d+\.\d\d +(\d+\.\d\d) )");
-  int rows = 0;
-  for (std::sregex_iterator m(out.begin(), out.end(), raw_ratio), end; m != end; ++m, ++rows)
-    EXPECT_GT(std::stod((*m)[1]), 0) << m->str();
-  EXPECT_EQ(rows, 2) << out;
+  EXPECT_NE(out.find("replay 1  replay many  PT/replay   min-max  PT/raw   min-max"), std::string::npos) << out;
+  expect_median_within_spread(out, 4);  // PT/replay and PT/raw, one row per thread count
   // The split of the one-thread pass: three shares that add up to the whole, Embree's share of
   // the raw replay, the Embree calls' time in the pass over the replay's, the rest a ray.
   std::smatch m;
