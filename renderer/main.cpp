@@ -2,6 +2,8 @@
 // without -f, the debug window (viewer.cpp).
 #include <chrono>
 #include <cstdio>
+#include <new>
+#include <string>
 
 #include "cli.h"
 #include "collada.h"
@@ -73,6 +75,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pathtracer: --script drives the window; it cannot be used with -f\n");
     return 1;
   }
+  std::string doing = "loading " + o.scene_path;  // what an out-of-memory message names
   try {
     if (!o.describe) check_image_output(o.output);  // before the render, not after it
     auto t0 = std::chrono::steady_clock::now();
@@ -85,6 +88,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "Loaded %s: %zu triangles, %zu spheres, %zu lights in %.3f s\n", o.scene_path.c_str(),
                    scene->triangle_count, scene->sphere_count, scene->lights.size(), load_s);
 
+    doing = "for a " + std::to_string(o.params.width) + "x" + std::to_string(o.params.height) +
+            " render (its per-pixel statistics and images); a smaller -r needs less";
     RenderSession session(*scene, o.params);
     ImageRGB reference;
     if (!o.reference.empty()) {
@@ -128,6 +133,9 @@ int main(int argc, char** argv) {
                 why == StopReason::finished ? "" : (std::string(", ") + stop_reason_name(why)).c_str(),
                 st.nonfinite ? (", " + std::to_string(st.nonfinite) + " non-finite samples dropped").c_str() : "");
     return 0;
+  } catch (const std::bad_alloc&) {  // its what() says only "std::bad_alloc"
+    std::fprintf(stderr, "pathtracer: out of memory %s\n", doing.c_str());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pathtracer: %s\n", e.what());
     return 1;

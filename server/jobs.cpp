@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <new>
 #include <random>
 #include <sstream>
 
@@ -570,7 +571,11 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lock(job->mutex);
     job->state = job->cancel ? JobState::cancelled : JobState::failed;
-    if (!job->cancel) job->message = e.what();
+    if (!job->cancel)  // bad_alloc's what() says only "std::bad_alloc"
+      job->message = dynamic_cast<const std::bad_alloc*>(&e)
+                         ? "out of memory for a " + std::to_string(job->spec.params.width) + "x" +
+                               std::to_string(job->spec.params.height) + " image; a smaller size needs less"
+                         : e.what();
     job->finished_at = now_unix();
     ++job->version;
     persist(*job);

@@ -312,3 +312,27 @@ TEST(Cli, ErrorLogTargetErrorAndReference) {
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("ref.exr"), std::string::npos) << r.output;
 }
+
+#if defined(__SANITIZE_ADDRESS__)
+#define PT_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define PT_TEST_ASAN 1
+#endif
+#endif
+
+// A render too large for the memory the process may use ends with a message that names the size,
+// not "std::bad_alloc", and writes no image.
+TEST(Cli, OutOfMemoryNamesTheRenderSize) {
+#ifdef PT_TEST_ASAN
+  GTEST_SKIP() << "ulimit -v and AddressSanitizer's shadow memory do not mix";
+#endif
+  const std::string out = test::temp_dir() + "/oom.png";
+  std::remove(out.c_str());
+  // 3 GB of address space; the film's statistics alone need about 12 GB.
+  RunResult r = run("-t 1 -s 1 -r 16384 16384 --quiet -f " + out + " " + write_tiny_scene(),
+                    std::string("ulimit -v 3000000; ") + PT_PATHTRACER);
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("pathtracer: out of memory for a 16384x16384 render"), std::string::npos) << r.output;
+  EXPECT_FALSE(test::file_exists(out));
+}

@@ -189,13 +189,16 @@ class Api:
 # ---- a real server process ----
 class Server:
     """`token`: started with --token and its Api sends it; `env`: extra environment; `limit_file_kib`:
-    the process may write files of at most that size (ulimit -f: a disk that fills up)."""
+    the process may write files of at most that size (ulimit -f: a disk that fills up);
+    `limit_memory_mib`: its address space (ulimit -v: memory that runs out)."""
 
-    def __init__(self, root, contract, threads=1, args=(), scenes=None, token=None, env=None, limit_file_kib=None):
+    def __init__(self, root, contract, threads=1, args=(), scenes=None, token=None, env=None, limit_file_kib=None,
+                 limit_memory_mib=None):
         self.root = Path(root)
         self.token = token
         self.env = env
         self.limit_file_kib = limit_file_kib
+        self.limit_memory_mib = limit_memory_mib
         self.data = self.root / "data"
         self.scenes = Path(scenes) if scenes else self.root / "scenes"
         self.contract = contract
@@ -211,8 +214,13 @@ class Server:
                "--threads", str(self.threads), *self.args]
         if self.token is not None:
             cmd += ["--token", self.token]
-        if self.limit_file_kib is not None:  # bash sets the limit, then becomes the server (same pid)
-            cmd = ["bash", "-c", f'ulimit -f {int(self.limit_file_kib)} && exec "$0" "$@"', *cmd]
+        limits = []
+        if self.limit_file_kib is not None:
+            limits.append(f"ulimit -f {int(self.limit_file_kib)}")
+        if self.limit_memory_mib is not None:
+            limits.append(f"ulimit -v {int(self.limit_memory_mib) * 1024}")
+        if limits:  # bash sets the limits, then becomes the server (same pid)
+            cmd = ["bash", "-c", " && ".join(limits) + ' && exec "$0" "$@"', *cmd]
         env = dict(os.environ, **self.env) if self.env else None
         self.log_path = self.root / f"server-{len(list(self.root.glob('server-*.log'))) + 1}.log"
         self.log = open(self.log_path, "wb")
