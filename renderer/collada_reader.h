@@ -10,6 +10,7 @@
 #include <cstring>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <vector>
 #include <pugixml.hpp>
@@ -66,43 +67,33 @@ class Reader {
   }
 
   // ---- values ----
-  std::vector<double> numbers(const pugi::xml_node& node) const {
-    std::vector<double> out;
+  std::vector<double> numbers(const pugi::xml_node& node) const { return values<double>(node, "a number"); }
+  std::vector<uint32_t> indices(const pugi::xml_node& node) const {
+    return values<uint32_t>(node, "a non-negative integer index");
+  }
+  // The whitespace-separated values of `node`'s text, each counted against the limits; a token that
+  // does not parse as T fails naming it as not `what`. Numbers may carry a '+' (from_chars takes none)
+  // and must be finite.
+  template <class T>
+  std::vector<T> values(const pugi::xml_node& node, const char* what) const {
+    constexpr bool real = std::is_floating_point_v<T>;
+    std::vector<T> out;
     const char* s = node.child_value();
     const char* end = s + std::strlen(s);
     while (s < end) {
       while (s < end && std::isspace((unsigned char)*s)) ++s;
       if (s >= end) break;
-      double v;
+      T v;
       const char* start = s;
-      if (*s == '+') ++s;
+      if (real && *s == '+') ++s;
       auto r = std::from_chars(s, end, v);
       if (r.ec != std::errc() || (r.ptr < end && !std::isspace((unsigned char)*r.ptr))) {
         const char* e = start;
         while (e < end && !std::isspace((unsigned char)*e)) ++e;
-        fail(node, "'" + std::string(start, std::min<size_t>(e - start, 40)) + "' is not a number");
+        fail(node, "'" + std::string(start, std::min<size_t>(e - start, 40)) + "' is not " + what);
       }
-      if (!std::isfinite(v)) fail(node, "non-finite number '" + clip(std::string(start, r.ptr - start)) + "'");
-      count_value(node);
-      out.push_back(v);
-      s = r.ptr;
-    }
-    return out;
-  }
-  std::vector<uint32_t> indices(const pugi::xml_node& node) const {
-    std::vector<uint32_t> out;
-    const char* s = node.child_value();
-    const char* end = s + std::strlen(s);
-    while (s < end) {
-      while (s < end && std::isspace((unsigned char)*s)) ++s;
-      if (s >= end) break;
-      uint32_t v;
-      auto r = std::from_chars(s, end, v);
-      if (r.ec != std::errc() || (r.ptr < end && !std::isspace((unsigned char)*r.ptr))) {
-        const char* e = s;
-        while (e < end && !std::isspace((unsigned char)*e)) ++e;
-        fail(node, "'" + std::string(s, std::min<size_t>(e - s, 40)) + "' is not a non-negative integer index");
-      }
+      if constexpr (real)
+        if (!std::isfinite(v)) fail(node, "non-finite number '" + clip(std::string(start, r.ptr - start)) + "'");
       count_value(node);
       out.push_back(v);
       s = r.ptr;
