@@ -196,12 +196,7 @@ double FilmAccumulator::error_estimate() const {
 }
 
 ImageRGB FilmAccumulator::image() const {
-  ImageRGB img;
-  img.width = m_w;
-  img.height = m_h;
-  img.pixels.resize(m_sum.size());
-  for (size_t i = 0; i < m_sum.size(); ++i) img.pixels[i] = pixel_mean(i);
-  return img;
+  return make_image(m_w, m_h, [this](size_t i) { return pixel_mean(i); });
 }
 
 void FilmAccumulator::read_tile(const Tile& t, std::vector<Vec3>& out) const {

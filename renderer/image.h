@@ -17,6 +17,17 @@ struct ImageRGB {
   const Vec3& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
 };
 
+// A width x height image whose pixel i (top row first) is pixel(i): how films hand out their means.
+template <class PixelAt>
+ImageRGB make_image(int width, int height, PixelAt pixel) {
+  ImageRGB img;
+  img.width = width;
+  img.height = height;
+  img.pixels.resize(size_t(width) * size_t(height));
+  for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = pixel(i);
+  return img;
+}
+
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 
 // Relative MSE on luminance, mean of (a - ref)^2 / (ref^2 + eps): the error measure the renderer

@@ -372,22 +372,12 @@ float autofocus_distance(const RenderScene& scene, float sx, float sy) {
 }
 
 ImageRGB RenderSession::image() const {
-  ImageRGB img;
-  img.width = m_w;
-  img.height = m_h;
-  img.pixels.resize(m_sum.size());
-  for (size_t i = 0; i < m_sum.size(); ++i) img.pixels[i] = pixel_mean(i);
-  return img;
+  return make_image(m_w, m_h, [this](size_t i) { return pixel_mean(i); });
 }
 
 ImageRGB RenderSession::caustic_image() const {
-  ImageRGB img;
-  img.width = m_w;
-  img.height = m_h;
-  img.pixels.assign(m_sum.size(), Vec3(0.0f));
-  if (m_lt_paths > 0)
-    for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = m_lt_sum[i] / float(m_lt_paths);
-  return img;
+  if (m_lt_paths == 0) return make_image(m_w, m_h, [](size_t) { return Vec3(0.0f); });
+  return make_image(m_w, m_h, [this](size_t i) { return m_lt_sum[i] / float(m_lt_paths); });
 }
 
 // Course colouring: 0 = blue, 0.5 = green, 1 = red, by samples taken / spp.
@@ -397,12 +387,7 @@ static Vec3 rate_colour(uint32_t count, int spp) {
 }
 
 ImageRGB RenderSession::rate_image() const {
-  ImageRGB img;
-  img.width = m_w;
-  img.height = m_h;
-  img.pixels.resize(m_sum.size());
-  for (size_t i = 0; i < m_sum.size(); ++i) img.pixels[i] = rate_colour(m_count[i], m_params.spp);
-  return img;
+  return make_image(m_w, m_h, [this](size_t i) { return rate_colour(m_count[i], m_params.spp); });
 }
 
 void RenderSession::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const {
