@@ -2,6 +2,7 @@
 // render settings of the comparison framing, medians (flags: args.h).
 #pragma once
 
+#include <sched.h>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -22,6 +23,31 @@ struct BenchScene {
   int max_depth = 5;
   float lens_radius = 0, focal_distance = 4.7f;
 };
+
+// The machine the numbers come from, which every benchmark prints first: this project's hosts
+// differ from run to run (2-CPU AMD EPYC with AVX2, 2-CPU Xeon with AVX-512, a 16-core device), and
+// the ratios differ with them (docs/performance.md). CPUs = those this process may run on.
+inline std::string host_description() {
+  std::string model = "unknown CPU";
+  if (FILE* f = std::fopen("/proc/cpuinfo", "r")) {
+    char line[512];
+    while (std::fgets(line, sizeof line, f)) {
+      const char* colon = std::strchr(line, ':');
+      if (std::strncmp(line, "model name", 10) != 0 || !colon) continue;
+      model = colon + 1;
+      model.erase(0, model.find_first_not_of(" \t"));
+      model.erase(model.find_last_not_of(" \t\n") + 1);
+      break;
+    }
+    std::fclose(f);
+  }
+  cpu_set_t set;
+  const int cpus = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : 0;
+  const char* isa = __builtin_cpu_supports("avx512f") ? "AVX-512" : __builtin_cpu_supports("avx2") ? "AVX2" : "SSE2";
+  return model + ", " + (cpus > 0 ? std::to_string(cpus) : std::string("?")) + " CPUs, " + isa;
+}
+
+inline void print_host(const char* prog) { std::printf("%s: host %s\n", prog, host_description().c_str()); }
 
 inline bool exists(const std::string& p) {
   struct stat st;

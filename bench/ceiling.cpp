@@ -88,6 +88,7 @@ int bench_main(int argc, char** argv) {
   args.finish();
 
   std::vector<BenchScene> scenes = bench_scenes("bench_ceiling", smoke, only);
+  print_host("bench_ceiling");
   std::printf("bench_ceiling: rays of one %d-spp pass at %s (keep_fov, m = 5, light_samples 1, no adaptive), "
               "%s sampler, replayed; rays/s are medians of %d runs\n",
               spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);

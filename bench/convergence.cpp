@@ -117,6 +117,7 @@ int bench_main(int argc, char** argv) {
 
   std::vector<BenchScene> scenes = bench_scenes("bench_convergence", smoke, only);
   make_dirs(out_dir);
+  print_host("bench_convergence");
   std::printf("bench_convergence: %s, keep_fov, light_samples 1, no adaptive sampling, 2 threads, %s sampler; %d spp "
               "against a %d-spp reference (independent sampler); seconds are the median of %d run(s)\n",
               smoke ? "64x48" : "480x360", sampler_name(sampler), spp, ref_spp, runs);

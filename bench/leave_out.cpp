@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
       if (exists(shared + f)) scenes.push_back(shared + f);
     scenes.push_back(std::string(PT_SOURCE_DIR) + "/scenes/cornell.dae");
   }
+  bench::print_host("bench_leave_out");
   // B/prim: bytes per triangle or sphere; shared: the SceneBase (Embree BVH and buffers, our
   // shading arrays, lights), file: the SceneDesc's arrays. Per-job set-up: a whole render scene
   // (make_render_scene, what a server job used to build) against a view of the shared base.

@@ -30,6 +30,7 @@ int bench_main(int argc, char** argv) {
   args.finish();
 
   std::vector<BenchScene> scenes = bench_scenes("bench_scaling", smoke, only);
+  print_host("bench_scaling");
   std::printf("bench_scaling: one %d-spp pass at %s (keep_fov, light_samples 1, no adaptive, %s sampler), median of "
               "%d runs\n",
               spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);

@@ -127,6 +127,23 @@ def mitsuba_scene(mi, folder, depth, spp, seed_unused=0):
     return mi.load_dict(scene)
 
 
+def host_description():
+    """CPU model, CPUs this process may use, widest vector ISA: as the C++ benchmarks print it."""
+    model, flags = "unknown CPU", set()
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                if key.strip() == "model name" and model == "unknown CPU":
+                    model = value.strip()
+                elif key.strip() == "flags" and not flags:
+                    flags = set(value.split())
+    except OSError:
+        pass
+    isa = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE2"
+    return f"{model}, {len(os.sched_getaffinity(0))} CPUs, {isa}"
+
+
 def run_ours(args, scene_path, depth, spp, out, seed, extra=()):
     cmd = [str(BUILD / "pathtracer"), "-t", "2", "-s", str(spp), "-l", "1", "-m", str(depth), "-r", "480", "360",
            "--keep-fov", "--no-adaptive", "--quiet", "--seed", str(seed), *extra, "-f", str(out), str(scene_path)]
@@ -163,6 +180,7 @@ def main():
     cache = BUILD / "bench-cache"
     cache.mkdir(parents=True, exist_ok=True)
     pixels = 480 * 360
+    print(f"vs_mitsuba: host {host_description()}")
     print(f"vs_mitsuba: 480x360 keep_fov, {args.spp} spp, 2 threads, medians of {args.runs}; references "
           f"{args.ref_spp} spp; Mitsuba {mi.__version__} llvm_ad_rgb ({llvm})"
           + (f"; ours with {args.ours}" if args.ours else ""))

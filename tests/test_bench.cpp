@@ -25,11 +25,23 @@ int run(const std::string& cmd, std::string& out) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// The benchmark's first line names the machine: its CPU model, the CPUs it may use and the widest
+// vector ISA, the one this test process sees.
+void expect_host_line(const std::string& out, const std::string& prog) {
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(prog + R"(: host (.+), (\d+) CPUs, (AVX-512|AVX2|SSE2)\n)"))) << out;
+  EXPECT_FALSE(m[1].str().empty()) << m.str();
+  EXPECT_GE(std::stoi(m[2]), 1) << m.str();
+  const char* isa = __builtin_cpu_supports("avx512f") ? "AVX-512" : __builtin_cpu_supports("avx2") ? "AVX2" : "SSE2";
+  EXPECT_EQ(m[3].str(), isa) << m.str();
+}
+
 void expect_runs(const std::string& binary, const std::string& flags, const std::string& header) {
   std::string out;
   int rc = run(std::string(PT_BENCH_DIR) + "/" + binary + " --smoke" + flags, out);
   EXPECT_EQ(rc, 0) << out;
   EXPECT_NE(out.find(header), std::string::npos) << "no table header '" << header << "' in:\n" << out;
+  expect_host_line(out, binary);
 }
 
 // A median of ratios within their min-max, one row per scene (a mix-up of the pairs or of
@@ -59,6 +71,7 @@ TEST(BenchSmoke, Convergence) {
 TEST(BenchSmoke, Ceiling) {
   std::string out;
   ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_ceiling --smoke --runs 3", out), 0) << out;
+  expect_host_line(out, "bench_ceiling");
   EXPECT_NE(out.find("replay 1  replay many  PT/replay   min-max  PT/raw   min-max"), std::string::npos) << out;
   expect_median_within_spread(out, 4);  // PT/replay and PT/raw, one row per thread count
   // The split of the one-thread pass: three shares that add up to the whole, Embree's share of
@@ -80,6 +93,7 @@ TEST(BenchSmoke, Ceiling) {
 TEST(BenchSmoke, Scaling) {
   std::string out;
   ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --smoke --runs 3", out), 0) << out;
+  expect_host_line(out, "bench_scaling");
   EXPECT_NE(out.find("samples/s 1t samples/s 2t   2t/1t   min-max"), std::string::npos) << out;
   EXPECT_NE(out.find("busy 1t  busy 2t   per-CPU"), std::string::npos) << out;
   expect_median_within_spread(out, 1);  // smoke: dof.dae only
