@@ -98,6 +98,19 @@ TEST(AccelMath, BoundsTestGivesTheScalarSlabsAnswer) {
   EXPECT_GT(misses, 20000);
 }
 
+namespace {
+// a * b + c where the compiler may use FMA: one rounding if it contracts, two if it does not.
+__attribute__((target("fma"), noinline)) float mul_add(float a, float b, float c) { return a * b + c; }
+}  // namespace
+
+// The build keeps products and sums as written (-ffp-contract=off, CMakeLists.txt) even in code
+// compiled for FMA, as -march=native compiles the renderer: the lanes' bit-for-bit tests rely on it.
+TEST(AccelMath, ProductsAndSumsRoundAsWritten) {
+  if (!__builtin_cpu_supports("fma")) GTEST_SKIP() << "no FMA on this CPU";
+  const float a = 1.0f + 0x1p-12f;  // a * a = 1 + 2^-11 + 2^-24: the last term is lost when rounded
+  EXPECT_EQ(mul_add(a, a, -(1.0f + 0x1p-11f)), 0.0f) << "a * b + c was fused into one FMA";
+}
+
 TEST(AccelMath, FourSphereTestsAtOnceGiveTheScalarTestsBits) {
   std::mt19937 rng(9);
   std::uniform_real_distribution<float> u(-1.f, 1.f);
