@@ -1,5 +1,6 @@
 // The pathtracer command: course flags -> load scene -> render -> write images -> summary line;
 // without -f, the debug window (viewer.cpp).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <new>
@@ -35,7 +36,15 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
   std::printf("shading normals:  %s\n", f.shading_normals ? "yes (curved meshes)" : "no (flat shading)");
   std::printf("camera:           %s\n", f.thin_lens ? "thin lens" : "pinhole");
   std::printf("adaptive:         %s\n", f.adaptive ? "on" : "off (spp <= batch, or --no-adaptive)");
-  std::printf("caustics:         %s\n", f.caustic_tracing ? "light traced" : "path traced only");
+  // The course's defaults (-s 1 -m 1) leave caustics path traced in scenes that light trace them
+  // at any real setting: say so, rather than let "path traced only" read as the scene's nature.
+  std::string caustics = f.caustic_tracing ? "light traced" : "path traced only";
+  RenderParams deeper = o.params;
+  deeper.spp = std::max(deeper.spp, 2);
+  deeper.max_depth = std::max(deeper.max_depth, 2);
+  if (!f.caustic_tracing && caustic_tracing_applies(scene, deeper))
+    caustics += " (-s 2 -m 2 or more would light-trace them)";
+  std::printf("caustics:         %s\n", caustics.c_str());
   std::printf("path loop:        %s%s%s%s\n", f.bits == kFeatAll ? "generic" : "specialised:",
               f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),

@@ -251,8 +251,11 @@ TEST(Cli, DescribePrintsTheFeatureSetAndMemory) {
   EXPECT_NE(r.output.find("lights:           area"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("specialised: delta no-microfacet no-infinite-lights"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("bytes per primitive"), std::string::npos) << r.output;
-  // The defaults (-s 1 -m 1): one sample is the pixel centre, and one bounce has no caustic.
-  EXPECT_NE(r.output.find("caustics:         path traced only"), std::string::npos) << r.output;
+  // The defaults (-s 1 -m 1): one sample is the pixel centre, and one bounce has no caustic; the
+  // line says what would light-trace them.
+  EXPECT_NE(r.output.find("caustics:         path traced only (-s 2 -m 2 or more would light-trace them)\n"),
+            std::string::npos)
+      << r.output;
   r = run("-s 16 -m 5 --describe " + test::own_scene("cornell.dae"));
   EXPECT_NE(r.output.find("caustics:         light traced"), std::string::npos) << r.output;
   r = run("--describe --generic " + test::own_scene("cornell.dae"));
@@ -265,9 +268,11 @@ TEST(Cli, DescribePrintsTheFeatureSetAndMemory) {
   r = run("--describe -H " + test::own_scene("cornell.dae"));  // its direct-light rays go one at a time
   EXPECT_NE(r.output.find("ray queries:      one path at a time"), std::string::npos) << r.output;
   r = run("-s 16 -m 5 --describe --no-caustic-tracing " + test::own_scene("cornell.dae"));
-  EXPECT_NE(r.output.find("caustics:         path traced only"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("caustics:         path traced only\n"), std::string::npos) << r.output;
   r = run("-s 16 -m 5 --describe " + test::own_scene("dof.dae"));  // no mirror or glass: nothing to trace
-  EXPECT_NE(r.output.find("caustics:         path traced only"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("caustics:         path traced only\n"), std::string::npos) << r.output;
+  r = run("--describe " + test::own_scene("dof.dae"));  // nor at any setting
+  EXPECT_NE(r.output.find("caustics:         path traced only\n"), std::string::npos) << r.output;
 }
 
 TEST(Cli, CausticLightPathsAreRecordedInTheExrHeader) {
