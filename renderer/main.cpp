@@ -2,6 +2,7 @@
 // without -f, the debug window (viewer.cpp).
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <new>
 #include <string>
@@ -136,9 +137,12 @@ int main(int argc, char** argv) {
     write_image(session.rate_image(), rate_image_path(o.output));
 
     SessionStats st = session.stats();
-    std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %.3g%s%s\n",
+    // The estimate compares two halves of each pixel's samples: with one sample a pixel there is none.
+    const double err = session.error_estimate();
+    const std::string err_text = format_error_estimate(err) + (std::isfinite(err) ? "" : " (needs 2 or more spp)");
+    std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %s%s%s\n",
                 o.output.c_str(), session.width(), session.height(), st.samples / pixels, o.params.spp, st.seconds,
-                st.samples / st.seconds, st.rays / st.seconds, session.error_estimate(),
+                st.samples / st.seconds, st.rays / st.seconds, err_text.c_str(),
                 why == StopReason::finished ? "" : (std::string(", ") + stop_reason_name(why)).c_str(),
                 st.nonfinite ? (", " + std::to_string(st.nonfinite) + " non-finite samples dropped").c_str() : "");
     return 0;

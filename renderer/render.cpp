@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <thread>
 
 #include <sys/mman.h>
@@ -470,6 +471,13 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
   size_t used = 0;
   for (size_t b = 0; b < blocks; ++b) sum += sums[b], used += useds[b];
   return used ? sum / double(n_pixels) : INFINITY;
+}
+
+std::string format_error_estimate(double error) {
+  if (!std::isfinite(error)) return "n/a";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", error);
+  return buf;
 }
 
 double RenderSession::error_estimate() const {

@@ -159,6 +159,10 @@ struct SplatStats {
   const std::vector<double>* half_s1 = nullptr;
   uint64_t n = 0, half_n = 0;
 };
+// An error estimate as the CLI, the window and the logs show it: "%.3g", or "n/a" while it is
+// infinite (before any pixel has two samples).
+std::string format_error_estimate(double error);
+
 double halves_error_estimate(int width, const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
                              const std::vector<double>& s1, const std::vector<double>& half_s1,
                              const SplatStats& splats = {}, int threads = 1);
@@ -210,7 +214,8 @@ class RenderSession {
   ImageRGB rate_image() const;   // the course's sample-rate colouring
   // The light-traced caustics alone (caustics.h), part of image(); black when they are path traced.
   ImageRGB caustic_image() const;
-  // Estimated relative MSE of the image, without a reference (see render.cpp).
+  // Estimated relative MSE of the image, without a reference (see render.cpp); infinite until
+  // some pixel has two samples to compare.
   double error_estimate() const;
   SessionStats stats() const;
   const std::vector<Tile>& tiles() const { return m_tiles; }

@@ -152,6 +152,12 @@ TEST(Cli, RendersPngRateImageAndExrWithMetadata) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("rays/s"), std::string::npos) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("error estimate [0-9.]+(e-?[0-9]+)?\\n"))) << r.output;
+  // One sample a pixel leaves no halves to compare: the summary says so instead of "inf".
+  r = run("-s 1 -m 2 -r 32 24 --quiet -f " + dir + "/one.png " + scene);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("error estimate n/a (needs 2 or more spp)"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("inf"), std::string::npos) << r.output;
   for (const char* name : {"/tiny.png", "/tiny_rate.png"}) {
     auto in = OIIO::ImageInput::open(dir + name);
     ASSERT_TRUE(in) << name;

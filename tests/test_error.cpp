@@ -157,3 +157,10 @@ TEST(ErrorEstimateBackground, AFrameOfBackgroundOnlyIsConvergedFromTwoSamples) {
       EXPECT_EQ(s.stats().samples, uint64_t(p.width) * p.height * p.spp);
     }
 }
+
+TEST(ErrorEstimateText, ANumberOrNotAvailableNeverInf) {
+  EXPECT_EQ(format_error_estimate(0.00123), "0.00123");
+  EXPECT_EQ(format_error_estimate(0), "0");
+  EXPECT_EQ(format_error_estimate(INFINITY), "n/a");
+  EXPECT_EQ(format_error_estimate(NAN), "n/a");
+}
