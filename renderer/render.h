@@ -159,8 +159,8 @@ struct SplatStats {
   const std::vector<double>* half_s1 = nullptr;
   uint64_t n = 0, half_n = 0;
 };
-// An error estimate as the CLI, the window and the logs show it: "%.3g", or "n/a" while it is
-// infinite (before any pixel has two samples).
+// An error estimate as the CLI's summary and the window show it: "%.3g", or "n/a" while it is
+// infinite (before any pixel has two samples). The CSV log keeps "inf", which parsers read.
 std::string format_error_estimate(double error);
 
 double halves_error_estimate(int width, const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,

@@ -412,8 +412,8 @@ class Viewer {
         std::snprintf(spp, sizeof spp, "restarting");
       std::snprintf(buf, sizeof buf,
                     "pathtracer: %s | %s | error %s | depth %d | lens %s | focus %s | light %d | %dx%d%s", name.c_str(),
-                    spp, format_error_estimate(current ? st.error : INFINITY).c_str(), p.max_depth, fmt_g(p.lens_radius).c_str(),
-                    fmt_g(p.focal_distance).c_str(), p.light_samples, p.width, p.height,
+                    spp, format_error_estimate(current ? st.error : INFINITY).c_str(), p.max_depth,
+                    fmt_g(p.lens_radius).c_str(), fmt_g(p.focal_distance).c_str(), p.light_samples, p.width, p.height,
                     m_show_rate ? " | rate view" : "");
     }
     if (m_title != buf) {

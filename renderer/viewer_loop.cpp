@@ -87,8 +87,8 @@ void RenderLoop::loop() {
       m_status = st;
       m_done = st.finished;
       if (!m_options.quiet)
-        say("pass: %d/%d spp, error estimate %s, %.2f s", st.reached_spp, st.spp, format_error_estimate(st.error).c_str(),
-            st.seconds);
+        say("pass: %d/%d spp, error estimate %s, %.2f s", st.reached_spp, st.spp,
+            format_error_estimate(st.error).c_str(), st.seconds);
       m_target = std::min(m_params.spp, m_target * 2);
     }
     lk.lock();
