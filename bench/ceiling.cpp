@@ -93,6 +93,7 @@ int bench_main(int argc, char** argv) {
               "%s sampler, replayed; rays/s are medians of %d runs\n",
               spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);
   std::vector<std::string> table, split;
+  TargetCheck target("PT/raw >= 0.70 on every scene, with 1 and " + std::to_string(many) + " threads", 0.70, smoke);
   int packet_width = 0;  // Accel's, the same for every scene (Embree's native width)
   ProgressBar bar("bench_ceiling");
   int done = 0;
@@ -206,6 +207,7 @@ int bench_main(int argc, char** argv) {
                     median(acc_many) / 1e6, median(paired), *lo, *hi, median(paired_raw), *raw_lo, *raw_hi, median(raw) / 1e6, median(stream) / 1e6,
                     median(packet) / 1e6, median(packet8) / 1e6);
       table.push_back(line);
+      target.add(median(paired_raw), sc.name + ", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads"));
     }
   }
   bar.finish();
@@ -219,6 +221,7 @@ int bench_main(int argc, char** argv) {
               "rtcIntersect1M / rtcOccluded1M, %zu rays a call; packet16 / packet8 = rtcIntersect16 / rtcOccluded16 and "
               "rtcIntersect8 / rtcOccluded8\n",
               RenderParams().ray_packets ? "in Embree packets" : "one ray at a time", packet_width, packet_width, batch);
+  std::printf("%s\n", target.verdict().c_str());
   std::printf("\nWhere the time goes, one thread (AccelTimer, summed over the runs):\n%-10s %10s %10s %10s %12s %13s %9s\n",
               "scene", "PT Embree", "PT refine", "PT rest", "raw Embree", "Embree PT/raw", "rest/ray");
   for (const std::string& l : split) std::printf("%s\n", l.c_str());

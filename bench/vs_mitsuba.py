@@ -235,13 +235,31 @@ def main():
         rows.append((name, depth, m_sec, pixels * args.spp / m_sec, m_err, o_sec, statistics.median(orate), o_err,
                      mean_m, mean_o, cross))
     print(header)
+    samples, efficiency = [], []  # ours over Mitsuba's, per scene
     for name, depth, m_sec, m_rate, m_err, o_sec, o_rate, o_err, mean_m, mean_o, cross in rows:
+        samples.append((name, o_rate / m_rate))
+        efficiency.append((name, (m_err * m_sec) / (o_err * o_sec)))
         print(f"{name:<10} {'mitsuba':<9} {m_sec:8.3f} {m_rate / 1e6:12.2f} {m_err:10.5f} {1 / (m_err * m_sec):11.1f}")
         print(f"{'(m=' + str(depth) + ')':<10} {'ours':<9} {o_sec:8.3f} {o_rate / 1e6:12.2f} {o_err:10.5f} "
               f"{1 / (o_err * o_sec):11.1f}")
-        print(f"{'':<10} ours/mitsuba: samples/s {o_rate / m_rate:.2f}x, efficiency "
-              f"{(m_err * m_sec) / (o_err * o_sec):.2f}x; references: mean luminance {mean_o:.4f} vs {mean_m:.4f} "
+        print(f"{'':<10} ours/mitsuba: samples/s {samples[-1][1]:.2f}x, efficiency "
+              f"{efficiency[-1][1]:.2f}x; references: mean luminance {mean_o:.4f} vs {mean_m:.4f} "
               f"({100 * (mean_o / mean_m - 1):+.1f}%), relMSE between them {cross:.5f}")
+    print(verdict("samples/s >= Mitsuba's on every scene", 1.0, samples))
+    print(verdict("efficiency 1/(relMSE x s) >= 2x Mitsuba's on every scene", 2.0, efficiency))
+
+
+def verdict(what, goal, cases):
+    """Issue 6's target against this run, as bench_ceiling and bench_scaling print theirs (bench_common.h):
+    met or not, the weakest case, and how many miss; ratios compare as printed, to two decimals."""
+    if not cases:
+        return f"target: {what}: nothing measured"
+    shown = [(name, round(v, 2)) for name, v in cases]
+    below = sum(1 for _, v in shown if not v >= goal)
+    name, low = min(shown, key=lambda c: c[1])
+    if below == 0:
+        return f"target: {what}: met on this host (lowest {low:.2f}x: {name})"
+    return f"target: {what}: not met on this host (lowest {low:.2f}x: {name}; {below} of {len(shown)} cases below {goal:.2f}x)"
 
 
 if __name__ == "__main__":

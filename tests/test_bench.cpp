@@ -9,6 +9,7 @@
 #include <string>
 
 #include "../bench/args.h"
+#include "../bench/bench_common.h"
 #include "test_util.h"
 
 namespace {
@@ -58,7 +59,63 @@ void expect_median_within_spread(const std::string& out, int rows_expected) {
   EXPECT_EQ(rows, rows_expected) << out;
 }
 
+// The verdict line of a benchmark's smoke run: met or not, the lowest value and its case.
+struct Verdict {
+  bool met;
+  double lowest;
+  std::string where;
+};
+Verdict find_verdict(const std::string& out, const std::string& what) {
+  std::smatch m;
+  const std::regex line("target: " + what + R"(: (met|not met) in this smoke run \(no measurement\) \(lowest (\d+\.\d\d): ([^;)]+)[;)])");
+  if (!std::regex_search(out, m, line)) throw std::runtime_error("no verdict for '" + what + "' in:\n" + out);
+  return {m[1] == "met", std::stod(m[2]), m[3]};
+}
+
+// The medians of the "median lo-hi" ratio columns of the table rows that start with `scene`.
+std::vector<std::vector<double>> row_ratios(const std::string& out, const std::string& scene) {
+  std::vector<std::vector<double>> rows;
+  std::regex row("\n" + scene + " [^\n]*"), ratio(R"( (\d+\.\d\d) (\d+\.\d\d)-(\d+\.\d\d) )");
+  for (std::sregex_iterator r(out.begin(), out.end(), row), end; r != end; ++r) {
+    const std::string text = r->str() + " ";
+    std::vector<double> medians;
+    for (std::sregex_iterator m(text.begin(), text.end(), ratio); m != std::sregex_iterator(); ++m)
+      medians.push_back(std::stod((*m)[1]));
+    if (!medians.empty()) rows.push_back(medians);
+  }
+  return rows;
+}
+
 }  // namespace
+
+// The verdict names the weakest case (as the tables print it, to two decimals) and counts the
+// cases below the goal; NaN is a miss, never a pass.
+TEST(BenchTarget, VerdictNamesTheWeakestCaseAndCountsMisses) {
+  bench::TargetCheck none("x >= 1", 1.0);
+  EXPECT_EQ(none.verdict(), "target: x >= 1: nothing measured");
+
+  bench::TargetCheck met("PT/raw >= 0.70", 0.70);
+  met.add(0.81, "a, 1 thread");
+  met.add(0.6951, "b, 2 threads");  // prints as 0.70: met, as the table shows it
+  met.add(0.75, "c, 1 thread");
+  EXPECT_EQ(met.verdict(), "target: PT/raw >= 0.70: met on this host (lowest 0.70: b, 2 threads)");
+
+  bench::TargetCheck missed("PT/raw >= 0.70", 0.70);
+  missed.add(0.72, "a, 1 thread");
+  missed.add(0.48, "b, 1 thread");
+  missed.add(0.694, "c, 2 threads");
+  EXPECT_EQ(missed.verdict(),
+            "target: PT/raw >= 0.70: not met on this host (lowest 0.48: b, 1 thread; 2 of 3 cases below 0.70)");
+  // A NaN is a miss and the case named, whatever comes after it.
+  missed.add(std::nan(""), "d, 2 threads");
+  missed.add(0.30, "e, 1 thread");
+  EXPECT_EQ(missed.verdict(),
+            "target: PT/raw >= 0.70: not met on this host (lowest nan: d, 2 threads; 4 of 5 cases below 0.70)");
+  // A smoke run's verdict says that it measured nothing.
+  bench::TargetCheck smoke("z >= 1", 1.0, true);
+  smoke.add(1.5, "dof");
+  EXPECT_EQ(smoke.verdict(), "target: z >= 1: met in this smoke run (no measurement) (lowest 1.50: dof)");
+}
 
 TEST(BenchSmoke, Convergence) {
   std::string dir = pt::test::temp_dir() + "/bench_smoke";
@@ -88,6 +145,16 @@ TEST(BenchSmoke, Ceiling) {
   EXPECT_LE(std::stod(m[4]), 100.0) << m.str();
   EXPECT_GT(std::stod(m[5]), 0) << m.str();
   EXPECT_GT(std::stod(m[6]), 0) << m.str();
+  // The target's verdict agrees with the table: its lowest is the smallest PT/raw (each row's
+  // second ratio) and it is met exactly when that reaches 0.70.
+  const auto rows = row_ratios(out, "dof");
+  ASSERT_EQ(rows.size(), 2u) << out;
+  ASSERT_EQ(rows[0].size(), 2u) << out;
+  ASSERT_EQ(rows[1].size(), 2u) << out;
+  const Verdict v = find_verdict(out, "PT/raw >= 0\\.70 on every scene, with 1 and 2 threads");
+  EXPECT_DOUBLE_EQ(v.lowest, std::min(rows[0][1], rows[1][1])) << out;
+  EXPECT_EQ(v.where, rows[0][1] <= rows[1][1] ? "dof, 1 thread" : "dof, 2 threads") << out;
+  EXPECT_EQ(v.met, v.lowest >= 0.70) << out;
 }
 
 TEST(BenchSmoke, Scaling) {
@@ -106,6 +173,12 @@ TEST(BenchSmoke, Scaling) {
     EXPECT_LE(std::stod(m[k]), 1.02) << m.str();
   }
   EXPECT_GT(std::stod(m[3]), 0) << m.str();
+  const auto rows = row_ratios(out, "dof");
+  ASSERT_EQ(rows.size(), 1u) << out;
+  const Verdict v = find_verdict(out, "2t/1t >= 1\\.85 on every scene");
+  EXPECT_DOUBLE_EQ(v.lowest, rows[0][0]) << out;
+  EXPECT_EQ(v.where, "dof") << out;
+  EXPECT_EQ(v.met, v.lowest >= 1.85) << out;
 }
 
 // --threads N sets the second column's thread count, which the header names; fewer than 2 is an
@@ -115,6 +188,7 @@ TEST(BenchSmoke, ScalingThreadCount) {
   ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --smoke --runs 1 --threads 3", out), 0) << out;
   EXPECT_NE(out.find("samples/s 1t samples/s 3t   3t/1t   min-max"), std::string::npos) << out;
   EXPECT_NE(out.find("busy 1t  busy 3t   per-CPU"), std::string::npos) << out;
+  EXPECT_NO_THROW(find_verdict(out, "3t/1t >= 2\\.78 on every scene")) << out;  // 0.925 of 3, as 1.85 is of 2
   EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --smoke --threads 1", out), 2) << out;
   EXPECT_NE(out.find("--threads must be a whole number from 2 to 1024, not '1'"), std::string::npos) << out;
 }
