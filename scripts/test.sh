@@ -12,6 +12,7 @@ if [ ! -f tests/web/node_modules/.package-lock.json ] ||
 fi
 bash scripts/python-env.sh  # build/venv: pytest, requests, jsonschema, schemathesis for tests/server
 (cd build && ctest --output-on-failure --timeout 900 -j "$(nproc)")
+bash scripts/main-smoke.sh  # the README's first command: the server with the bundled scenes and the page
 # The C++ and server tests again under AddressSanitizer + UBSan (build-asan), then the scene loader
 # under libFuzzer for a minute (build-fuzz); docs/reliability.md has the longer runs.
 bash scripts/asan.sh
