@@ -45,10 +45,13 @@ void expect_runs(const std::string& binary, const std::string& flags, const std:
   expect_host_line(out, binary);
 }
 
+// A ratio column of the benchmarks' tables: "median lo-hi", two decimals each.
+const std::regex kRatio(R"( (\d+\.\d\d) (\d+\.\d\d)-(\d+\.\d\d) )");
+
 // A median of ratios within their min-max, one row per scene (a mix-up of the pairs or of
 // min and max fails it).
 void expect_median_within_spread(const std::string& out, int rows_expected) {
-  std::regex ratio(R"( (\d+\.\d\d) (\d+\.\d\d)-(\d+\.\d\d) )");
+  const std::regex& ratio = kRatio;
   int rows = 0;
   for (std::sregex_iterator m(out.begin(), out.end(), ratio), end; m != end; ++m, ++rows) {
     double median = std::stod((*m)[1]), lo = std::stod((*m)[2]), hi = std::stod((*m)[3]);
@@ -75,11 +78,11 @@ Verdict find_verdict(const std::string& out, const std::string& what) {
 // The medians of the "median lo-hi" ratio columns of the table rows that start with `scene`.
 std::vector<std::vector<double>> row_ratios(const std::string& out, const std::string& scene) {
   std::vector<std::vector<double>> rows;
-  std::regex row("\n" + scene + " [^\n]*"), ratio(R"( (\d+\.\d\d) (\d+\.\d\d)-(\d+\.\d\d) )");
+  const std::regex row("\n" + scene + " [^\n]*");
   for (std::sregex_iterator r(out.begin(), out.end(), row), end; r != end; ++r) {
     const std::string text = r->str() + " ";
     std::vector<double> medians;
-    for (std::sregex_iterator m(text.begin(), text.end(), ratio); m != std::sregex_iterator(); ++m)
+    for (std::sregex_iterator m(text.begin(), text.end(), kRatio); m != std::sregex_iterator(); ++m)
       medians.push_back(std::stod((*m)[1]));
     if (!medians.empty()) rows.push_back(medians);
   }
