@@ -7,7 +7,9 @@
 // (rtcIntersect1M / rtcOccluded1M), and raw packets of 16 (rtcIntersect16 / rtcOccluded16, as
 // Mitsuba 3's LLVM variants trace on AVX-512) and of 8 (rtcIntersect8 / rtcOccluded8). The path
 // tracer's own rays/s on the same pass over the replay's is the share of its time the ray queries
-// would take if nothing else cost anything.
+// would take if nothing else cost anything. Beside it, with one thread, the same ratio for a
+// minimal path loop on the same pixels (bench/minimal_loop.h): what a loop that keeps only its rays
+// reaches against the raw replay of those rays.
 //
 //   bench_ceiling [--spp 16] [--runs 5] [--threads N] [--scene NAME] [--sampler sobol|independent] [--smoke]
 #include <algorithm>
@@ -20,6 +22,7 @@
 
 #include "bench_common.h"
 #include "collada.h"
+#include "minimal_loop.h"
 #include "progress.h"
 #include "render.h"
 
@@ -31,6 +34,8 @@ namespace {
 const char* kUsage = "bench_ceiling [--spp N=16] [--runs N=5] [--threads N=2] [--batch N=256] [--scene NAME] [--sampler sobol|independent] [--smoke]";
 
 enum class Mode { accel, accel_many, raw, stream, packet16, packet8 };
+
+std::atomic<size_t> g_replayed_hits{0};  // replayed hits, so that no replay is optimised away
 
 size_t replay(const Accel& a, const RayRecorder& rec, size_t begin, size_t end, Mode mode, size_t batch) {
   const Ray* rays = rec.rays.data();
@@ -92,12 +97,12 @@ int bench_main(int argc, char** argv) {
   std::printf("bench_ceiling: rays of one %d-spp pass at %s (keep_fov, m = 5, light_samples 1, no adaptive), "
               "%s sampler, replayed; rays/s are medians of %d runs\n",
               spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);
-  std::vector<std::string> table, split;
+  std::vector<std::string> table, split, minimal;
   TargetCheck target("PT/raw >= 0.70 on every scene, with 1 and " + std::to_string(many) + " threads", 0.70, smoke);
   int packet_width = 0;  // Accel's, the same for every scene (Embree's native width)
   ProgressBar bar("bench_ceiling");
   int done = 0;
-  const int total = int(scenes.size()) * 2 * 7 * runs;
+  const int total = int(scenes.size()) * (2 * 7 + 2) * runs;
   for (BenchScene sc : scenes) {
     sc.max_depth = 5;
     SceneDesc desc = load_collada(sc.path);
@@ -133,6 +138,18 @@ int bench_main(int argc, char** argv) {
 
     const Accel& accel = *scene->accel;
     packet_width = accel.packet_width();
+    // The minimal loop's own rays, recorded the same way.
+    const std::vector<int> pixels = scene_pixels(*scene, p);
+    RayRecorder minimal_rec;
+    record_rays_on_this_thread(&minimal_rec);
+    minimal_loop_pass(*scene, pixels, p.width, p.height, spp);
+    record_rays_on_this_thread(nullptr);
+    size_t minimal_shadows = 0;
+    for (uint8_t s : minimal_rec.shadow) minimal_shadows += s;
+    std::vector<double> minimal_ratio;
+    AccelTimer minimal_timer;
+    uint64_t minimal_ticks = 0, minimal_rays = 0;
+    double pt_rest_per_ray = 0;
     for (Mode m : {Mode::accel, Mode::accel_many, Mode::raw, Mode::stream, Mode::packet16, Mode::packet8})
       replay_rate(accel, rec, 1, m, batch);  // warm up
     for (int threads : {1, many}) {
@@ -172,16 +189,32 @@ int bench_main(int argc, char** argv) {
         stream.push_back(replay_timed(Mode::stream));
         packet.push_back(replay_timed(Mode::packet16));
         packet8.push_back(replay_timed(Mode::packet8));
+        if (timed) {  // the minimal loop and the raw replay of its rays, paired as PT/raw is
+          time_accel_on_this_thread(&minimal_timer);
+          const uint64_t m0 = accel_ticks();
+          const MinimalLoopResult loop = minimal_loop_pass(*scene, pixels, p.width, p.height, spp);
+          minimal_ticks += accel_ticks() - m0;
+          time_accel_on_this_thread(nullptr);
+          minimal_rays += loop.rays;
+          bar.update(double(++done) / total);
+          const auto r0 = std::chrono::steady_clock::now();
+          g_replayed_hits += accel.cast_raw(minimal_rec.rays.data(), minimal_rec.shadow.data(), minimal_rec.rays.size(),
+                                            packet_width == 16 ? Accel::RawMode::packet16 : Accel::RawMode::packet8,
+                                            size_t(packet_width));
+          const double raw_sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+          bar.update(double(++done) / total);
+          minimal_ratio.push_back((double(loop.rays) / loop.seconds) / (double(minimal_rec.rays.size()) / raw_sec));
+        }
       }
       if (timed) {
         // PT/raw is (Embree's share of PT's time) / (its share of the replay's) when the calls
         // themselves take as long in both: "Embree PT/raw" says how far that holds.
+        pt_rest_per_ray = double(pt_ticks - pt_timer.embree - pt_timer.refine) / double(runs) / double(rec.rays.size());
         char line[256];
         std::snprintf(line, sizeof line, "%-10s %9.1f%% %9.1f%% %9.1f%% %11.1f%% %13.2f %9.1f", sc.name.c_str(),
                       100.0 * pt_timer.embree / pt_ticks, 100.0 * pt_timer.refine / pt_ticks,
                       100.0 * (pt_ticks - pt_timer.embree - pt_timer.refine) / pt_ticks, 100.0 * raw_timer.embree / raw_ticks,
-                      double(pt_timer.embree) / double(raw_timer.embree),
-                      double(pt_ticks - pt_timer.embree - pt_timer.refine) / double(runs) / double(rec.rays.size()));
+                      double(pt_timer.embree) / double(raw_timer.embree), pt_rest_per_ray);
         split.push_back(line);
       }
       // The path tracer casts packets unless told not to; its ceiling is the replay the same way.
@@ -208,6 +241,15 @@ int bench_main(int argc, char** argv) {
                     median(packet) / 1e6, median(packet8) / 1e6);
       table.push_back(line);
       target.add(median(paired_raw), sc.name + ", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads"));
+      if (timed) {
+        const auto [lo_m, hi_m] = std::minmax_element(minimal_ratio.begin(), minimal_ratio.end());
+        const double rest = double(minimal_ticks - minimal_timer.embree - minimal_timer.refine) / double(minimal_rays);
+        char row[256];
+        std::snprintf(row, sizeof row, "%-10s %8.2f M %7.1f%% %10.2f %4.2f-%4.2f %9.1f %9.1f %11.2f", sc.name.c_str(),
+                      minimal_rec.rays.size() / 1e6, 100.0 * minimal_shadows / std::max<size_t>(1, minimal_rec.rays.size()),
+                      median(minimal_ratio), *lo_m, *hi_m, rest, pt_rest_per_ray, median(paired_raw) / median(minimal_ratio));
+        minimal.push_back(row);
+      }
     }
   }
   bar.finish();
@@ -235,6 +277,13 @@ int bench_main(int argc, char** argv) {
 #else
               "nanoseconds");
 #endif
+  std::printf("\nA minimal path loop on the same pixels, one thread (bench/minimal_loop.h):\n%-10s %10s %8s %10s %9s %9s %9s %11s\n",
+              "scene", "rays", "shadow", "loop/raw", "min-max", "rest/ray", "PT rest", "PT/loop");
+  for (const std::string& l : minimal) std::printf("%s\n", l.c_str());
+  std::printf("loop/raw = the minimal loop's rays/s over the raw replay of its own rays (packets of %d), median of the runs "
+              "(min-max); rest/ray = its own time a ray, PT rest = the path tracer's (above); PT/loop = PT/raw (1 thread) over "
+              "loop/raw: how near the path tracer comes to a loop that keeps only its rays\n",
+              packet_width);
   return 0;
 }
 

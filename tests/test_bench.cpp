@@ -133,7 +133,8 @@ TEST(BenchSmoke, Ceiling) {
   ASSERT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_ceiling --smoke --runs 3", out), 0) << out;
   expect_host_line(out, "bench_ceiling");
   EXPECT_NE(out.find("replay 1  replay many  PT/replay   min-max  PT/raw   min-max"), std::string::npos) << out;
-  expect_median_within_spread(out, 4);  // PT/replay and PT/raw, one row per thread count
+  // PT/replay and PT/raw, one row per thread count, and the minimal loop's loop/raw
+  expect_median_within_spread(out, 5);
   // The split of the one-thread pass: three shares that add up to the whole, Embree's share of
   // the raw replay, the Embree calls' time in the pass over the replay's, the rest a ray.
   std::smatch m;
@@ -148,16 +149,33 @@ TEST(BenchSmoke, Ceiling) {
   EXPECT_LE(std::stod(m[4]), 100.0) << m.str();
   EXPECT_GT(std::stod(m[5]), 0) << m.str();
   EXPECT_GT(std::stod(m[6]), 0) << m.str();
+  const double pt_rest = std::stod(m[6]);
   // The target's verdict agrees with the table: its lowest is the smallest PT/raw (each row's
   // second ratio) and it is met exactly when that reaches 0.70.
   const auto rows = row_ratios(out, "dof");
-  ASSERT_EQ(rows.size(), 2u) << out;
+  ASSERT_EQ(rows.size(), 3u) << out;  // 1 and 2 threads, then the minimal loop's row
   ASSERT_EQ(rows[0].size(), 2u) << out;
   ASSERT_EQ(rows[1].size(), 2u) << out;
+  ASSERT_EQ(rows[2].size(), 1u) << out;
   const Verdict v = find_verdict(out, "PT/raw >= 0\\.70 on every scene, with 1 and 2 threads");
   EXPECT_DOUBLE_EQ(v.lowest, std::min(rows[0][1], rows[1][1])) << out;
   EXPECT_EQ(v.where, rows[0][1] <= rows[1][1] ? "dof, 1 thread" : "dof, 2 threads") << out;
   EXPECT_EQ(v.met, v.lowest >= 0.70) << out;
+  // The minimal loop (bench/minimal_loop.h) on the same pixels: its own rays (a shadow ray for
+  // every hit, so some but not all of them), its rest a ray, the path tracer's rest a ray as the
+  // split above prints it, and PT/loop = the one-thread PT/raw over loop/raw.
+  std::regex loop(R"(\ndof +(\d+\.\d\d) M +(\d+\.\d)% +(\d+\.\d\d) \d+\.\d\d-\d+\.\d\d +(\d+\.\d) +(\d+\.\d) +(\d+\.\d\d)\n)");
+  ASSERT_TRUE(std::regex_search(out, m, loop)) << out;
+  EXPECT_GT(std::stod(m[1]), 0) << m.str();
+  EXPECT_GT(std::stod(m[2]), 0) << m.str();
+  EXPECT_LE(std::stod(m[2]), 50) << m.str();  // at most one shadow ray an intersect ray
+  EXPECT_GT(std::stod(m[4]), 0) << m.str();
+  EXPECT_DOUBLE_EQ(std::stod(m[5]), pt_rest) << m.str();
+  const double loop_raw = std::stod(m[3]);
+  EXPECT_GT(loop_raw, 0) << m.str();
+  // Each printed ratio is rounded to two decimals: the quotient's error bound, plus its own rounding.
+  const double pt_raw = rows[0][1];
+  EXPECT_NEAR(std::stod(m[6]), pt_raw / loop_raw, 0.0051 + 0.0051 / loop_raw + 0.0051 * pt_raw / (loop_raw * loop_raw)) << m.str();
 }
 
 TEST(BenchSmoke, Scaling) {
