@@ -35,8 +35,6 @@ const char* kUsage = "bench_ceiling [--spp N=16] [--runs N=5] [--threads N=2] [-
 
 enum class Mode { accel, accel_many, raw, stream, packet16, packet8 };
 
-std::atomic<size_t> g_replayed_hits{0};  // replayed hits, so that no replay is optimised away
-
 size_t replay(const Accel& a, const RayRecorder& rec, size_t begin, size_t end, Mode mode, size_t batch) {
   const Ray* rays = rec.rays.data();
   const uint8_t* shadow = rec.shadow.data();
@@ -197,13 +195,9 @@ int bench_main(int argc, char** argv) {
           time_accel_on_this_thread(nullptr);
           minimal_rays += loop.rays;
           bar.update(double(++done) / total);
-          const auto r0 = std::chrono::steady_clock::now();
-          g_replayed_hits += accel.cast_raw(minimal_rec.rays.data(), minimal_rec.shadow.data(), minimal_rec.rays.size(),
-                                            packet_width == 16 ? Accel::RawMode::packet16 : Accel::RawMode::packet8,
-                                            size_t(packet_width));
-          const double raw_sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+          const double raw_rate = replay_rate(accel, minimal_rec, 1, packet_width == 16 ? Mode::packet16 : Mode::packet8, batch);
           bar.update(double(++done) / total);
-          minimal_ratio.push_back((double(loop.rays) / loop.seconds) / (double(minimal_rec.rays.size()) / raw_sec));
+          minimal_ratio.push_back((double(loop.rays) / loop.seconds) / raw_rate);
         }
       }
       if (timed) {
