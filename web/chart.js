@@ -1,6 +1,15 @@
 // The error chart: the job's estimated error against time, log-log.
 'use strict';
 
+// The dashed guide: the relative MSE of an unbiased Monte Carlo estimate falls as 1/time (slope -1
+// on log-log axes; its square root, the RMSE, would fall as 1/sqrt(time)). It runs through the
+// latest point, where the ETA towards a target error extrapolates from (server/jobs.cpp), since
+// the first passes' estimates run high (docs/performance.md, eighteenth session).
+function errorGuide(points) {
+  const last = points[points.length - 1];
+  return { slope: -1, seconds: last.seconds, error: last.error };
+}
+
 function drawChart(canvas, points) {
   const dpr = window.devicePixelRatio || 1;
   const cw = canvas.clientWidth || 300, ch = canvas.clientHeight || 120;
@@ -71,7 +80,8 @@ function drawChart(canvas, points) {
   ctx.globalAlpha = 1;
   ctx.textAlign = 'right';
   for (const t of ty.labels) ctx.fillText(t.text, L - 6, Math.min(T + H, Math.max(T + 8, Y(t.v) + 4)));
-  // Reference: Monte Carlo error falls as 1/sqrt(time), through the first point.
+  const guide = errorGuide(pts);
+  const guideY = (x) => Math.log10(guide.error) + guide.slope * (x - Math.log10(guide.seconds));
   ctx.save();
   ctx.beginPath();
   ctx.rect(L, T, W, H);
@@ -79,8 +89,8 @@ function drawChart(canvas, points) {
   ctx.setLineDash([4, 4]);
   ctx.strokeStyle = muted;
   ctx.beginPath();
-  ctx.moveTo(X(x0), Y(ly[0] - 0.5 * (x0 - lx[0])));
-  ctx.lineTo(X(x1), Y(ly[0] - 0.5 * (x1 - lx[0])));
+  ctx.moveTo(X(x0), Y(guideY(x0)));
+  ctx.lineTo(X(x1), Y(guideY(x1)));
   ctx.stroke();
   ctx.restore();
 

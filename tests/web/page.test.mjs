@@ -223,6 +223,11 @@ test('tiles stream into the canvas and match the final image; cancel stops a job
   // The chart has points and the stats are filled in.
   assert.match(await page.textContent('#v-spp'), /^8 \/ 8$/);
   assert.notEqual(await page.textContent('#v-error'), '–');
+  // The chart's dashed guide is Monte Carlo's rate for a relative MSE, 1/time, through the latest
+  // point (against an RMSE's 1/sqrt(time), half as steep, the render looked faster than Monte Carlo allows).
+  const guide = await page.evaluate(() => errorGuide([{ seconds: 0.5, error: 0.4 }, { seconds: 2, error: 0.05 }]));
+  assert.deepEqual(guide, { slope: -1, seconds: 2, error: 0.05 });
+  assert.match(await page.textContent('.chart-box figcaption'), /relative MSE.*1\/t through the latest point/);
 });
 
 test('clicking the image sets the focal distance from the focus endpoint', async () => {
