@@ -1,6 +1,7 @@
 // The pathtracer command: course flags -> load scene -> render -> write images -> summary line;
 // without -f, the debug window (viewer.cpp).
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -117,7 +118,22 @@ int main(int argc, char** argv) {
     }
     ProgressBar bar("Rendering", !o.quiet);
     double pixels = double(session.width()) * session.height();
+    // The bar shows the latest pass's error estimate, and its ETA follows that estimate's decay
+    // towards --target-error (remaining_seconds), not only the sample budget; so does its fill, the
+    // share of the expected time gone (the sample fraction itself when the budget decides).
+    const auto render_start = std::chrono::steady_clock::now();
+    auto since_start = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count(); };
+    std::atomic<double> last_error{INFINITY}, last_error_at{0};
+    auto on_tile = [&](const Tile&) {
+      const double err = last_error.load(), elapsed = since_start(), progress = session.progress();
+      const double eta = remaining_seconds(elapsed, progress, err, last_error_at.load(), o.limits);
+      // Below 1 until done: the bar redraws at once for 1, which would be every tile.
+      const double fill = std::min(0.999, eta >= 0 && elapsed + eta > 0 ? elapsed / (elapsed + eta) : progress);
+      bar.update(fill, std::isfinite(err) ? "error " + format_error_estimate(err) : std::string(), eta);
+    };
     auto on_pass = [&](const PassReport& r) {
+      last_error_at = since_start();
+      last_error = r.error;
       if (!log) return;
       std::fprintf(log, "%.6f,%.4f,%.6g", r.seconds, session.stats().samples / pixels, r.error);
       if (!reference.pixels.empty()) {
@@ -127,7 +143,7 @@ int main(int argc, char** argv) {
       std::fprintf(log, "\n");
       std::fflush(log);
     };
-    StopReason why = run_progressive(session, o.limits, nullptr, [&](const Tile&) { bar.update(session.progress()); }, on_pass);
+    StopReason why = run_progressive(session, o.limits, nullptr, on_tile, on_pass);
     bar.finish();
     if (log) std::fclose(log);
 

@@ -17,15 +17,16 @@ class ProgressBar {
         m_start(std::chrono::steady_clock::now()) {}
   ~ProgressBar() { finish(); }
 
-  // fraction in [0, 1]; redraws at most 10 times a second. Safe from several threads.
-  void update(double fraction, const std::string& extra = "") {
+  // fraction in [0, 1]; redraws at most 10 times a second. Safe from several threads. The ETA is
+  // `eta` seconds where that is given (>= 0), else the time the remaining fraction would take.
+  void update(double fraction, const std::string& extra = "", double eta = -1) {
     if (!m_enabled) return;
     std::lock_guard<std::mutex> lock(m_mutex);
     auto now = std::chrono::steady_clock::now();
     if (fraction < 1 && now - m_last < std::chrono::milliseconds(100)) return;
     m_last = now;
     double elapsed = std::chrono::duration<double>(now - m_start).count();
-    double eta = fraction > 1e-6 ? elapsed * (1 - fraction) / fraction : 0;
+    if (eta < 0) eta = fraction > 1e-6 ? elapsed * (1 - fraction) / fraction : 0;
     const int width = 30;
     int filled = int(fraction * width + 0.5);
     std::string bar(size_t(filled), '#');

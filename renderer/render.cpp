@@ -310,6 +310,27 @@ const char* stop_reason_name(StopReason r) {
   return "?";
 }
 
+double remaining_seconds(double elapsed, double progress, double error, double error_seconds, const RunLimits& limits) {
+  double eta = progress > 0 ? elapsed * (1 - progress) / progress : -1;
+  auto sooner = [&eta](double t) { eta = eta < 0 ? t : std::min(eta, t); };
+  if (limits.target_error > 0 && std::isfinite(error) && error > 0)
+    sooner(std::max(0.0, error_seconds * error / limits.target_error - elapsed));
+  if (limits.time_limit > 0) sooner(std::max(0.0, limits.time_limit - elapsed));
+  return eta;
+}
+
+int next_pass_target(int target, int spp, double error, double target_error) {
+  int next = std::min(spp, target * 2);
+  if (target_error > 0 && std::isfinite(error) && error > target_error) {
+    // error ~ 1/spp: the count where it meets the target, 5% past it so that noise in the estimate
+    // rarely needs one more pass, and at least a quarter more than now so that passes stay few.
+    const double needed = std::ceil(double(target) * (error / target_error) * 1.05);
+    const double least = double(target) + std::max(1.0, std::floor(target / 4.0));
+    if (needed < double(next)) next = int(std::max(needed, least));
+  }
+  return std::min(next, spp);
+}
+
 StopReason run_progressive(RenderSession& s, const RunLimits& limits, const std::atomic<bool>* cancel,
                            const RenderSession::TileCallback& on_tile,
                            const std::function<void(const PassReport&)>& on_pass) {
@@ -319,7 +340,7 @@ StopReason run_progressive(RenderSession& s, const RunLimits& limits, const std:
                                std::chrono::duration<double>(limits.time_limit)));
   const int spp = s.params().spp;
   StopReason reason = StopReason::finished;
-  for (int target = 1;; target = std::min(spp, target * 2)) {
+  for (int target = 1;;) {
     bool completed = s.render_pass(target, cancel, on_tile);
     double err = s.error_estimate();
     if (on_pass) on_pass({target, s.stats().seconds, err});
@@ -332,6 +353,7 @@ StopReason run_progressive(RenderSession& s, const RunLimits& limits, const std:
       break;
     }
     if (s.finished() || target >= spp) break;
+    target = next_pass_target(target, spp, err, limits.target_error);
   }
   s.set_deadline(std::chrono::steady_clock::time_point::max());
   return reason;

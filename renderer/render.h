@@ -325,6 +325,13 @@ struct RunLimits {
   double time_limit = 0;     // seconds of rendering; 0 = none
   double target_error = 0;   // stop once error_estimate() <= this; 0 = none
 };
+// Seconds left of a progressive render `elapsed` seconds in: from the sample budget (`progress`,
+// the fraction done), or sooner from the error estimate `error` measured at `error_seconds`, which
+// an unbiased estimator's relative MSE lowers as 1/time towards limits.target_error (not a
+// sample fraction: most of the budget may never be needed), or sooner still from the time limit.
+// Negative while none of them says anything (no progress, no limit). The CLI's progress bar and
+// the job service's ETA both use it.
+double remaining_seconds(double elapsed, double progress, double error, double error_seconds, const RunLimits& limits);
 enum class StopReason { finished, target_error, time_limit, cancelled };
 const char* stop_reason_name(StopReason r);
 struct PassReport {
@@ -332,9 +339,13 @@ struct PassReport {
   double seconds;   // rendering time so far
   double error;     // error_estimate() after the pass
 };
-// The progressive driver: passes of doubling sample counts (1, 2, 4, ... spp) until every pixel
-// is done, the error target or time limit is reached, or `cancel` is set. `on_pass` runs after
-// each pass (also the last, partial one).
+// The samples per pixel the pass after one that reached `target` aims for: twice as many (1, 2, 4,
+// ... spp), or, towards an error target, where the estimate's 1/spp decay meets it when that comes
+// sooner (a doubling could overshoot it by up to the render's whole time so far).
+int next_pass_target(int target, int spp, double error, double target_error);
+// The progressive driver: passes of next_pass_target's sample counts until every pixel is done,
+// the error target or time limit is reached, or `cancel` is set. `on_pass` runs after each pass
+// (also the last, partial one).
 StopReason run_progressive(RenderSession& session, const RunLimits& limits, const std::atomic<bool>* cancel = nullptr,
                            const RenderSession::TileCallback& on_tile = {},
                            const std::function<void(const PassReport&)>& on_pass = {});

@@ -465,12 +465,10 @@ class JobStateSink : public JobSink {
         j.error_estimate = r.error;
         j.history.push_back({j.elapsed, double(r.samples) / (double(j.width) * j.height), r.error});
       }
-      // ETA from the sample budget, or (when sooner) from error ~ 1/spp towards the target.
-      double eta = j.progress > 0 ? j.elapsed * (1 - j.progress) / j.progress : -1;
-      if (j.spec.target_error > 0 && std::isfinite(r.error) && r.error > 0)
-        eta = std::min(eta < 0 ? 1e30 : eta, j.elapsed * std::max(0.0, r.error / j.spec.target_error - 1));
-      if (j.spec.time_limit > 0) eta = std::min(eta < 0 ? 1e30 : eta, std::max(0.0, j.spec.time_limit - j.elapsed));
-      j.eta = eta;
+      pt::RunLimits limits;
+      limits.target_error = j.spec.target_error;
+      limits.time_limit = j.spec.time_limit;
+      j.eta = pt::remaining_seconds(j.elapsed, j.progress, r.error, j.elapsed, limits);
       ++j.version;
       if (std::chrono::steady_clock::now() - m_last_persist > std::chrono::seconds(1)) {
         m_persist(j);

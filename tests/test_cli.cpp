@@ -4,10 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <pty.h>
 #include <regex>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
+#include <cerrno>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -322,6 +325,59 @@ TEST(Cli, ErrorLogTargetErrorAndReference) {
   r = run("-s 2 -r 20 10 --quiet --reference " + dir + "/ref.exr -f " + dir + "/bad.png " + scene);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("ref.exr"), std::string::npos) << r.output;
+}
+
+// Runs argv[0] with argv on a pseudo-terminal (where the progress bar draws) and returns what it
+// wrote there, stdout and stderr together.
+std::string run_on_terminal(const std::vector<std::string>& argv, int& status) {
+  int terminal = -1;
+  const pid_t pid = forkpty(&terminal, nullptr, nullptr, nullptr);
+  if (pid < 0) {
+    status = -1;
+    return "forkpty failed";
+  }
+  if (pid == 0) {
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  std::string out;
+  char buf[4096];
+  for (;;) {  // read() fails with EIO once the child has closed the terminal
+    const ssize_t n = read(terminal, buf, sizeof buf);
+    if (n > 0) out.append(buf, size_t(n));
+    else if (n < 0 && errno == EINTR) continue;
+    else break;
+  }
+  int st = 0;
+  waitpid(pid, &st, 0);
+  close(terminal);
+  status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return out;
+}
+
+// On a terminal the progress bar shows the latest error estimate, and with --target-error its ETA
+// follows that estimate's 1/time decay (remaining_seconds), not the sample budget: a budget of
+// 2^20 spp, which the target ends at 2048 (about 2 s), would give ETAs of many minutes from its
+// fraction.
+TEST(Cli, ProgressBarShowsTheErrorAndItsEtaTowardsTheTarget) {
+  const std::string out = test::temp_dir() + "/bar.png";
+  int status = 0;
+  const std::string text =
+      run_on_terminal({PT_PATHTRACER, "-t", "2", "-s", "1048576", "-r", "128", "96", "--keep-fov", "--no-adaptive",
+                       "--target-error", "0.00002", "-f", out, test::own_scene("cornell.dae")},
+                      status);
+  ASSERT_EQ(status, 0) << text;
+  EXPECT_NE(text.find("error target reached"), std::string::npos) << text;
+  const std::regex drawn(R"(ETA ([0-9.]+)s error ([0-9.e+-]+))");
+  int lines = 0;
+  for (std::sregex_iterator m(text.begin(), text.end(), drawn), end; m != end; ++m, ++lines) {
+    EXPECT_LT(std::stod((*m)[1]), 120.0) << m->str();
+    EXPECT_GT(std::stod((*m)[2]), 0.0) << m->str();
+  }
+  EXPECT_GE(lines, 1) << text;
 }
 
 #if defined(__SANITIZE_ADDRESS__)

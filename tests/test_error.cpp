@@ -164,3 +164,67 @@ TEST(ErrorEstimateText, ANumberOrNotAvailableNeverInf) {
   EXPECT_EQ(format_error_estimate(INFINITY), "n/a");
   EXPECT_EQ(format_error_estimate(NAN), "n/a");
 }
+
+// The ETA of a progressive render: from the sample budget, sooner from the error estimate's 1/time
+// decay towards a target, sooner still from a time limit; negative while nothing is known.
+TEST(RemainingSeconds, FollowsTheBudgetTheErrorsDecayAndTheTimeLimit) {
+  const RunLimits none;
+  EXPECT_LT(remaining_seconds(1.0, 0.0, INFINITY, 0.0, none), 0);
+  EXPECT_NEAR(remaining_seconds(2.0, 0.25, 0.1, 2.0, none), 6.0, 1e-9);  // a quarter done in 2 s
+  RunLimits target;
+  target.target_error = 0.01;
+  // 0.04 at 2 s reaches 0.01 at 8 s: 6 s left, sooner than the budget's 18 s; 5 s left at 3 s.
+  EXPECT_NEAR(remaining_seconds(2.0, 0.1, 0.04, 2.0, target), 6.0, 1e-9);
+  EXPECT_NEAR(remaining_seconds(3.0, 0.1, 0.04, 2.0, target), 5.0, 1e-9);
+  EXPECT_NEAR(remaining_seconds(2.0, 0.1, 0.005, 2.0, target), 0.0, 1e-9);     // already below the target
+  EXPECT_NEAR(remaining_seconds(2.0, 0.5, 0.04, 2.0, target), 2.0, 1e-9);      // the budget ends sooner
+  EXPECT_NEAR(remaining_seconds(2.0, 0.5, INFINITY, 2.0, target), 2.0, 1e-9);  // no estimate yet
+  RunLimits limit;
+  limit.time_limit = 3.0;
+  EXPECT_NEAR(remaining_seconds(2.0, 0.1, 0.04, 2.0, limit), 1.0, 1e-9);
+  EXPECT_NEAR(remaining_seconds(5.0, 0.0, INFINITY, 0.0, limit), 0.0, 1e-9);  // past the limit
+}
+
+// Towards an error target a pass aims where the estimate's 1/spp decay meets the target when that
+// comes sooner than doubling, so that the render stops near the target, not up to a doubling past.
+TEST(NextPassTarget, AimsWhereTheErrorMeetsTheTargetWhenThatIsSoonerThanDoubling) {
+  EXPECT_EQ(next_pass_target(64, 4096, 0.1, 0), 128);          // no target: doubling
+  EXPECT_EQ(next_pass_target(64, 100, 0.1, 0), 100);           // never past the budget
+  EXPECT_EQ(next_pass_target(64, 4096, 0.1, 0.01), 128);       // 640 needed: doubling comes first
+  EXPECT_EQ(next_pass_target(64, 4096, 0.013, 0.01), 88);      // 83.2 needed, 5% past it: 87.4
+  EXPECT_EQ(next_pass_target(64, 4096, 0.0101, 0.01), 80);     // 64.6 needed: a quarter more at least
+  EXPECT_EQ(next_pass_target(1, 4096, 0.0101, 0.01), 2);       // one more at least
+  EXPECT_EQ(next_pass_target(64, 4096, INFINITY, 0.01), 128);  // no estimate yet
+  EXPECT_EQ(next_pass_target(64, 70, 0.013, 0.01), 70);        // the budget still caps it
+}
+
+TEST(NextPassTarget, ARenderStopsNearItsErrorTargetNotADoublingPast) {
+  SceneDesc desc = load_collada(test::own_scene("dof.dae"));
+  RenderParams p;
+  p.file_camera = true;
+  p.width = 64;
+  p.height = 48;
+  p.max_depth = 3;
+  p.adaptive = false;
+  p.threads = 2;
+  p.spp = 4096;
+  auto scene = make_render_scene(desc, p);
+  // The error at 64 spp, then a target a quarter below it: 1/spp reaches it near 85 spp, where
+  // doubling passes would render 128.
+  double error64 = 0;
+  {
+    RenderSession s(*scene, p);
+    s.render_pass(64);
+    error64 = s.error_estimate();
+  }
+  RunLimits limits;
+  limits.target_error = 0.75 * error64;
+  RenderSession s(*scene, p);
+  std::vector<PassReport> passes;
+  const StopReason why = run_progressive(s, limits, nullptr, {}, [&](const PassReport& r) { passes.push_back(r); });
+  EXPECT_EQ(why, StopReason::target_error);
+  ASSERT_GE(passes.size(), 8u);
+  EXPECT_EQ(passes[6].target_spp, 64);  // 1, 2, 4, ... 64 as before
+  EXPECT_LT(passes.back().target_spp, 128);
+  EXPECT_LE(passes.back().error, limits.target_error);
+}
