@@ -79,17 +79,21 @@ void RenderLoop::loop() {
     RenderSession* s = m_session.get();
     bool ok = s->render_pass(m_target, &m_sh.cancel, [this, gen, s](const Tile& t) { send_tile(gen, *s, t); });
     if (ok) {
+      // --target-error ends the window's render as it ends a file render (run_progressive), with
+      // the same pass sizes towards it.
+      const double target_error = m_options.limits.target_error;
       Status st = m_status;
       st.reached_spp = m_target;
-      st.finished = m_target >= m_params.spp || s->finished();
       st.error = s->error_estimate();
+      const bool on_target = target_error > 0 && st.error <= target_error;
+      st.finished = m_target >= m_params.spp || s->finished() || on_target;
       st.seconds = s->stats().seconds;
       m_status = st;
       m_done = st.finished;
       if (!m_options.quiet)
-        say("pass: %d/%d spp, error estimate %s, %.2f s", st.reached_spp, st.spp,
-            format_error_estimate(st.error).c_str(), st.seconds);
-      m_target = std::min(m_params.spp, m_target * 2);
+        say("pass: %d/%d spp, error estimate %s, %.2f s%s", st.reached_spp, st.spp,
+            format_error_estimate(st.error).c_str(), st.seconds, on_target ? ", error target reached" : "");
+      m_target = next_pass_target(m_target, m_params.spp, st.error, target_error);
     }
     lk.lock();
     if (ok) m_sh.status = m_status;

@@ -3,6 +3,7 @@
 // click focuses on the surface under it, S / D write next to the scene, resizing re-renders at
 // the window size, and restarting or closing never waits for a long pass.
 #include <gtest/gtest.h>
+
 #include <dirent.h>
 #include <fcntl.h>
 #include <poll.h>
@@ -15,6 +16,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "cli.h"
@@ -214,6 +216,21 @@ TEST_F(Viewer, FramebufferMatchesTheCliRender) {
   // The sample-rate view shows the CLI's _rate.png (adaptive sampling stops some pixels early).
   EXPECT_LT(mean_abs_diff_levels(m_dir + "/window_rate.png", m_dir + "/cli_rate.png"), 0.5);
   std::printf("window vs CLI: %.4f levels; window run %.2f s\n", d, w.seconds);
+}
+
+// --target-error ends the window's render as it ends a file render: the pass that reaches it is
+// the last, well short of the sample budget, and the title says the render is done.
+TEST_F(Viewer, TheErrorTargetEndsTheRender) {
+  RunResult r = run_window("-t 2 -s 65536 -m 3 -r 64 48 --target-error 0.01", "wait_spp 65536\ntitle\nquit\n");
+  const std::string& o = r.output;
+  const std::string pass = last_line_with(o, "pass: ");
+  EXPECT_NE(pass.find("error target reached"), std::string::npos) << o;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(pass, m, std::regex(R"(pass: (\d+)/65536 spp, error estimate ([0-9.e+-]+))"))) << pass;
+  EXPECT_LT(std::stoi(m[1]), 65536) << pass;
+  EXPECT_LE(std::stod(m[2]), 0.01) << pass;
+  const std::string title = last_line_with(o, "title: ");
+  EXPECT_NE(title.find(std::string(m[1]) + "/65536 spp done"), std::string::npos) << title;
 }
 
 TEST_F(Viewer, KeysChangeTheSettingsTheyName) {
