@@ -11,18 +11,24 @@
 using namespace pt;
 
 
+// A small render of dof.dae through its own camera: depth 3, no adaptive sampling, 2 threads.
+RenderParams small_dof(int width, int height, int spp) {
+  RenderParams p;
+  p.file_camera = true;
+  p.width = width;
+  p.height = height;
+  p.max_depth = 3;
+  p.adaptive = false;
+  p.threads = 2;
+  p.spp = spp;
+  return p;
+}
+
 class ErrorEstimate : public ::testing::TestWithParam<SamplerKind> {};
 
 TEST_P(ErrorEstimate, StaysWithinAFactorOf1p5OfTheTrueErrorAcrossTheRun) {
   SceneDesc desc = load_collada(test::own_scene("dof.dae"));
-  RenderParams p;
-  p.file_camera = true;
-  p.width = 40;
-  p.height = 30;
-  p.max_depth = 3;
-  p.adaptive = false;
-  p.threads = 2;
-  p.spp = 4096;
+  RenderParams p = small_dof(40, 30, 4096);
   p.seed = 99;
   auto scene = make_render_scene(desc, p);
   RenderSession ref(*scene, p);
@@ -200,14 +206,7 @@ TEST(NextPassTarget, AimsWhereTheErrorMeetsTheTargetWhenThatIsSoonerThanDoubling
 
 TEST(NextPassTarget, ARenderStopsNearItsErrorTargetNotADoublingPast) {
   SceneDesc desc = load_collada(test::own_scene("dof.dae"));
-  RenderParams p;
-  p.file_camera = true;
-  p.width = 64;
-  p.height = 48;
-  p.max_depth = 3;
-  p.adaptive = false;
-  p.threads = 2;
-  p.spp = 4096;
+  const RenderParams p = small_dof(64, 48, 4096);
   auto scene = make_render_scene(desc, p);
   // The error at 64 spp, then a target a quarter below it: 1/spp reaches it near 85 spp, where
   // doubling passes would render 128.
