@@ -118,7 +118,7 @@ void sample_area_light_point(const Light& light, Vec2 u, Vec3& point, Vec3& norm
   Vec2 b = sample_uniform_triangle({ux, u.y});
   const Vec3* v = &light.triangles[3 * t];
   point = v[0] * b.x + v[1] * b.y + v[2] * (1 - b.x - b.y);
-  normal = normalize(cross(v[1] - v[0], v[2] - v[0]));
+  normal = light.triangle_normals[t];
 }
 
 bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s) {

@@ -43,6 +43,7 @@ struct Light {
   float cos_cutoff = -1; // spot: cosine of the half angle
   float exponent = 0;    // spot fall-off exponent
   std::vector<Vec3> triangles;  // mesh: three corners per triangle, world space
+  std::vector<Vec3> triangle_normals;  // mesh: each triangle's unit normal, kept off the sampling path
   Distribution1D triangle_distribution;
   const EnvironmentMap* env = nullptr;
 

@@ -133,6 +133,7 @@ SceneBase make_scene_base(const SceneDesc& desc) {
     for (size_t t = 0; t < areas.size(); ++t) {
       const Vec3* v = &l.triangles[3 * t];
       areas[t] = 0.5f * length(cross(v[1] - v[0], v[2] - v[0]));
+      l.triangle_normals.push_back(normalize(cross(v[1] - v[0], v[2] - v[0])));
       total += areas[t];
     }
     l.area = float(total);
@@ -194,7 +195,7 @@ size_t SceneBase::memory_bytes() const {
   bytes += materials.capacity() * sizeof(Material) + lights.capacity() * sizeof(Light);
   bytes += object_bounds.capacity() * sizeof(Bounds3) + caustic_targets.capacity() * sizeof(CausticTarget);
   for (const Light& l : lights)  // mesh lights: corners, and the area distribution (float + double cdf)
-    bytes += l.triangles.capacity() * sizeof(Vec3) + l.triangle_distribution.size() * (sizeof(float) + sizeof(double));
+    bytes += (l.triangles.capacity() + l.triangle_normals.capacity()) * sizeof(Vec3) + l.triangle_distribution.size() * (sizeof(float) + sizeof(double));
   return bytes;
 }
 
