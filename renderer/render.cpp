@@ -419,6 +419,30 @@ void RenderSession::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const 
     for (int x = t.x0; x < t.x1; ++x) out.push_back(rate_colour(m_count[size_t(y) * m_w + x], m_params.spp));
 }
 
+namespace {
+
+// A 3x3 neighbourhood's level, from its nine pixel means: the median, and the mean of the eight
+// below the largest (one firefly cannot lift it). The median by the 19 compare-exchanges of the
+// classic median-of-9 network (Paeth, Graphics Gems, 1990), branch-free.
+struct NeighbourhoodLevel {
+  double median, trimmed_mean;
+};
+inline NeighbourhoodLevel neighbourhood_level(const double in[9]) {
+  double v[9], sum = 0, top = in[0];
+#pragma GCC unroll 9
+  for (int k = 0; k < 9; ++k) v[k] = in[k], sum += in[k], top = std::max(top, in[k]);
+  auto sort2 = [&](int i, int j) {
+    double lo = std::min(v[i], v[j]), hi = std::max(v[i], v[j]);
+    v[i] = lo, v[j] = hi;
+  };
+  sort2(1, 2), sort2(4, 5), sort2(7, 8), sort2(0, 1), sort2(3, 4), sort2(6, 7), sort2(1, 2), sort2(4, 5);
+  sort2(7, 8), sort2(0, 3), sort2(5, 8), sort2(4, 7), sort2(3, 6), sort2(1, 4), sort2(2, 5), sort2(4, 7);
+  sort2(4, 2), sort2(6, 4), sort2(4, 2);
+  return {v[4], (sum - top) / 8};
+}
+
+}  // namespace
+
 double halves_error_estimate(int width, const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
                              const std::vector<double>& s1, const std::vector<double>& half_s1,
                              const SplatStats& splats, int threads) {
@@ -427,15 +451,20 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
   // mean A of samples [0, P) with the mean B of [P, n):
   // E[(A - B)^2] P (n - P) / n^2 = sigma^2 / n for independent samples, and unlike the sample
   // variance it also sees the faster convergence of stratified (Sobol) samples, each half of
-  // which is itself well stratified. mu is the pixel's mean, except for a firefly (a rare bright
-  // sample: the mean is over 3 times the median of its 3x3 neighbourhood's and one half's mean over
-  // 3 times the other's), which would divide its own error by its inflated mean: there mu is the
-  // larger of that median and the smaller half's mean. Without this the estimate fell to a third
-  // of the true relMSE on CBspheres at m = 100 (docs/performance.md); always taking the median
-  // overestimated small images with bright edges (1.6x on a 40x30 render).
-  // One pass and no per-pixel array: a pixel's mean is computed where it is read, its neighbours'
-  // only for the rare firefly. It runs between passes, in blocks of pixels on the render's threads;
-  // the blocks' sums are added in block order, so the estimate does not depend on the thread count.
+  // which is itself well stratified.
+  // mu stands for the pixel's true mean, which the true relMSE divides by. The pixel's own mean is
+  // a poor stand-in both ways (docs/performance.md, nineteenth session):
+  // - above its neighbourhood, a mean lifted by one half's rare bright sample divides its own
+  //   error away (CBspheres at m = 100 fell to 0.6 of the truth): mu is at most the larger of the
+  //   neighbourhood's median and the smaller half's mean;
+  // - a small, noisy mean of few samples inflates the ratio (E[1/mu^2] > 1/E[mu]^2: CBdragon 7x
+  //   the truth at 2 spp): mu is lifted towards the neighbourhood's level, its mean without its
+  //   largest value, but no further than one standard error above the pixel's own mean, so a
+  //   pixel that is surely darker than its neighbours (an edge) keeps its own mean, and the lift
+  //   fades as samples accumulate.
+  // It runs between passes, in blocks of rows on the render's threads; each block keeps its rows'
+  // means (and the rows on either side) in a buffer, and the blocks' sums are added in block order,
+  // so the estimate does not depend on the thread count.
   const size_t n_pixels = count.size();
   const bool with_splats = splats.n > 0;
   const double splat_n = double(splats.n);
@@ -444,46 +473,55 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
     if (with_splats) m += (*splats.s1)[i] / splat_n;
     return m;
   };
-  const int w = std::max(1, width), h = int(n_pixels / size_t(w));
-  const bool grid = h > 0 && size_t(w) * size_t(h) == n_pixels;
-  auto block = [&](size_t begin, size_t end, double& sum, size_t& used) {
-    for (size_t i = begin; i < end; ++i) {
-      uint32_t n = count[i], p = half_n[i];
-      if (n < 2 || p == 0 || p >= n) continue;
-      ++used;
-      if (s1[i] == 0 && half_s1[i] == 0 && !with_splats) continue;  // a black pixel adds exactly 0
-      double a = half_s1[i] / p, b = (s1[i] - half_s1[i]) / (n - p);
-      double var_mean = (a - b) * (a - b) * double(p) * double(n - p) / (double(n) * n);
-      if (with_splats) {
-        double sp = double(splats.half_n), t1 = (*splats.s1)[i];
-        if (sp > 0 && sp < splat_n) {
-          double sa = (*splats.half_s1)[i] / sp, sb = (t1 - (*splats.half_s1)[i]) / (splat_n - sp);
-          var_mean += (sa - sb) * (sa - sb) * sp * (splat_n - sp) / (splat_n * splat_n);
+  // A film that is not width x rows (none is, but the caller passes width and pixels apart) is
+  // read as one row.
+  size_t w = size_t(std::max(1, width)), h = n_pixels / w;
+  if (w * h != n_pixels) w = std::max<size_t>(1, n_pixels), h = n_pixels ? 1 : 0;
+  auto block = [&](size_t y0, size_t y1, double& block_sum, size_t& block_used) {
+    double sum = 0;
+    size_t used = 0;
+    const size_t r0 = y0 > 0 ? y0 - 1 : 0, r1 = std::min(h, y1 + 1);  // rows kept: y0 - 1 .. y1
+    std::vector<double> means((r1 - r0) * w);
+    for (size_t y = r0; y < r1; ++y)
+      for (size_t x = 0; x < w; ++x) means[(y - r0) * w + x] = mean_at(y * w + x);
+    for (size_t y = y0; y < y1; ++y) {
+      const double* rows[3] = {&means[((y > 0 ? y - 1 : y) - r0) * w], &means[(y - r0) * w],
+                               &means[((y + 1 < h ? y + 1 : y) - r0) * w]};  // edges repeat
+      for (size_t x = 0; x < w; ++x) {
+        const size_t i = y * w + x;
+        uint32_t n = count[i], p = half_n[i];
+        if (n < 2 || p == 0 || p >= n) continue;
+        ++used;
+        if (s1[i] == 0 && half_s1[i] == 0 && !with_splats) continue;  // a black pixel adds exactly 0
+        double a = half_s1[i] / p, b = (s1[i] - half_s1[i]) / (n - p);
+        double var_mean = (a - b) * (a - b) * double(p) * double(n - p) / (double(n) * n);
+        if (with_splats) {
+          double sp = double(splats.half_n), t1 = (*splats.s1)[i];
+          if (sp > 0 && sp < splat_n) {
+            double sa = (*splats.half_s1)[i] / sp, sb = (t1 - (*splats.half_s1)[i]) / (splat_n - sp);
+            var_mean += (sa - sb) * (sa - sb) * sp * (splat_n - sp) / (splat_n * splat_n);
+          }
         }
+        const size_t xl = x > 0 ? x - 1 : x, xr = x + 1 < w ? x + 1 : x;
+        const double v[9] = {rows[0][xl], rows[0][x], rows[0][xr], rows[1][xl], rows[1][x],
+                             rows[1][xr], rows[2][xl], rows[2][x], rows[2][xr]};
+        const double own = v[4];
+        const NeighbourhoodLevel level = neighbourhood_level(v);
+        double mu = std::min(own, std::max(level.median, std::min(a, b)));
+        mu = std::max(mu, std::min(level.trimmed_mean, own + std::sqrt(var_mean)));
+        sum += var_mean / (mu * mu + kRelMseEpsilon);
       }
-      double mu = mean_at(i);
-      // A firefly: from one half only (a bright edge is in both), and far above its neighbours.
-      if (std::max(a, b) > 3 * std::min(a, b) && grid) {
-        int x = int(i % size_t(w)), y = int(i / size_t(w));
-        double v[9];
-        int k = 0;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx)
-            v[k++] = mean_at(size_t(std::clamp(y + dy, 0, h - 1)) * size_t(w) + size_t(std::clamp(x + dx, 0, w - 1)));
-        std::nth_element(v, v + 4, v + 9);
-        if (mu > 3 * v[4]) mu = std::max(v[4], std::min(a, b));
-      }
-      sum += var_mean / (mu * mu + kRelMseEpsilon);
     }
+    block_sum = sum, block_used = used;
   };
-  constexpr size_t kBlock = 1 << 14;  // pixels; starting a thread costs about what a few thousand do
-  const size_t blocks = (n_pixels + kBlock - 1) / kBlock;
+  const size_t rows_per_block = std::max<size_t>(1, (size_t(1) << 14) / w);  // starting a thread costs about what a few thousand pixels do
+  const size_t blocks = (h + rows_per_block - 1) / rows_per_block;
   std::vector<double> sums(blocks, 0.0);
   std::vector<size_t> useds(blocks, 0);
   std::atomic<size_t> next{0};
   auto worker = [&] {
     for (size_t b; (b = next.fetch_add(1)) < blocks;)
-      block(b * kBlock, std::min(n_pixels, (b + 1) * kBlock), sums[b], useds[b]);
+      block(b * rows_per_block, std::min(h, (b + 1) * rows_per_block), sums[b], useds[b]);
   };
   std::vector<std::thread> pool;
   for (int t = 1; t < std::min<int>(threads, int(blocks)); ++t) pool.emplace_back(worker);
