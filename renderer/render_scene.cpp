@@ -132,8 +132,9 @@ SceneBase make_scene_base(const SceneDesc& desc) {
     double total = 0;
     for (size_t t = 0; t < areas.size(); ++t) {
       const Vec3* v = &l.triangles[3 * t];
-      areas[t] = 0.5f * length(cross(v[1] - v[0], v[2] - v[0]));
-      l.triangle_normals.push_back(normalize(cross(v[1] - v[0], v[2] - v[0])));
+      const Vec3 c = cross(v[1] - v[0], v[2] - v[0]);
+      areas[t] = 0.5f * length(c);
+      l.triangle_normals.push_back(normalize(c));
       total += areas[t];
     }
     l.area = float(total);
@@ -194,7 +195,7 @@ size_t SceneBase::memory_bytes() const {
   size_t bytes = accel ? accel->memory_bytes() : 0;
   bytes += materials.capacity() * sizeof(Material) + lights.capacity() * sizeof(Light);
   bytes += object_bounds.capacity() * sizeof(Bounds3) + caustic_targets.capacity() * sizeof(CausticTarget);
-  for (const Light& l : lights)  // mesh lights: corners, and the area distribution (float + double cdf)
+  for (const Light& l : lights)  // mesh lights: corners, normals, and the area distribution (float + double cdf)
     bytes += (l.triangles.capacity() + l.triangle_normals.capacity()) * sizeof(Vec3) + l.triangle_distribution.size() * (sizeof(float) + sizeof(double));
   return bytes;
 }
