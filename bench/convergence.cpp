@@ -1,8 +1,9 @@
 // bench_convergence: error against run time. Per scene it renders (once, cached) a high-spp
 // reference with our renderer, then renders progressively (1, 2, 4, ... spp) and logs per pass the
 // rendering seconds, the true relMSE and RMSE against the reference and the session's own error
-// estimate; writes a CSV and a log-log plot per scene and prints the efficiency
-// 1 / (relMSE x seconds), samples/s and rays/s. Numbers only: it asserts nothing about speed.
+// estimate, and the estimate over the truth; writes a CSV and a log-log plot per scene and prints
+// the efficiency 1 / (relMSE x seconds), samples/s and rays/s, and a verdict line on the estimate
+// staying within 1.5x of the truth from 16 spp. Numbers only: it asserts nothing about speed.
 //
 //   bench_convergence [--spp 256] [--ref-spp 1024] [--runs 3] [--scene NAME] [--sampler sobol|independent] [--depth M] [--out DIR]
 //                     [--cache DIR] [--rebuild-ref] [--smoke]
@@ -108,7 +109,7 @@ int bench_main(int argc, char** argv) {
   Args args(argc, argv, kUsage);
   if (args.help()) return 0;
   const auto [smoke, spp, runs, only, sampler] = common_flags(args, 256, 4, 3);
-  const int ref_spp = args.integer("--ref-spp", smoke ? 16 : 1024, 1, 1 << 24);
+  const int ref_spp = args.integer("--ref-spp", smoke ? 256 : 1024, 1, 1 << 24);
   const int depth = args.integer("--depth", -1, -1, 1000000);  // overrides every scene's max depth
   const std::string out_dir = args.value("--out", std::string(PT_BINARY_DIR) + "/bench-results");
   const std::string cache = args.value("--cache", std::string(PT_BINARY_DIR) + "/bench-cache");
@@ -122,6 +123,11 @@ int bench_main(int argc, char** argv) {
               "against a %d-spp reference (independent sampler); seconds are the median of %d run(s)\n",
               smoke ? "64x48" : "480x360", sampler_name(sampler), spp, ref_spp, runs);
   std::vector<std::string> summary;
+  // The estimate against the truth (relMSE less the reference's own noise), as the issue's
+  // factor 1.5: min(est/true, true/est) >= 1/1.5 on every pass from 16 spp (the first passes
+  // read high with the Sobol sampler: docs/performance.md, nineteenth session).
+  TargetCheck within_1p5("the estimate within 1.5x of the true error from 16 spp, min(est/true, true/est) >= 0.67",
+                         0.67, smoke);
   for (const BenchScene& sc : scenes) {
     SceneDesc desc = load_collada(sc.path);
     RenderParams p = bench_params(sc, smoke);
@@ -193,12 +199,18 @@ int bench_main(int argc, char** argv) {
                 png_path);
 
     // Per-pass log.
-    std::printf("%-10s %6s %9s %11s %10s %10s %10s %10s %11s\n", "scene", "spp", "seconds", "rays/sample", "relMSE",
-                "RMSE", "estimate", "ref floor", "efficiency");
-    for (const PassRow& row : rows)
-      std::printf("%-10s %6d %9.3f %11.2f %10.4g %10.4g %10.4g %10.3g %11.1f\n", sc.name.c_str(), row.spp, row.seconds,
-                  double(row.rays) / std::max<uint64_t>(1, row.samples), row.rel_mse, row.rmse, row.estimate,
-                  ref.error_estimate, 1.0 / (row.rel_mse * row.seconds));
+    std::printf("%-10s %6s %9s %11s %10s %10s %10s %10s %8s %11s\n", "scene", "spp", "seconds", "rays/sample",
+                "relMSE", "RMSE", "estimate", "ref floor", "est/true", "efficiency");
+    for (const PassRow& row : rows) {
+      // NaN where the truth is lost in the reference's noise, or before any pixel has two samples.
+      const double truth = row.rel_mse - ref.error_estimate;
+      const double ratio = truth > 0 && std::isfinite(row.estimate) ? row.estimate / truth : NAN;
+      std::printf("%-10s %6d %9.3f %11.2f %10.4g %10.4g %10.4g %10.3g %8.2f %11.1f\n", sc.name.c_str(), row.spp,
+                  row.seconds, double(row.rays) / std::max<uint64_t>(1, row.samples), row.rel_mse, row.rmse,
+                  row.estimate, ref.error_estimate, ratio, 1.0 / (row.rel_mse * row.seconds));
+      if (row.spp >= 16)
+        within_1p5.add(std::min(ratio, 1 / ratio), sc.name + ", " + std::to_string(row.spp) + " spp");
+    }
     std::printf("wrote %s and %s\n\n", csv_path.c_str(), png_path.c_str());
 
     const PassRow& last = rows.back();
@@ -216,6 +228,7 @@ int bench_main(int argc, char** argv) {
               "rays/s", "rays/spl", "relMSE", "estimate", "ref floor", "eff@64", "eff@final");
   for (const std::string& l : summary) std::printf("%s\n", l.c_str());
   std::printf("efficiency = 1 / (true relMSE x seconds), the reference's noise not subtracted\n");
+  std::printf("%s\n", within_1p5.verdict().c_str());
   return 0;
 }
 

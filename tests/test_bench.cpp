@@ -37,12 +37,13 @@ void expect_host_line(const std::string& out, const std::string& prog) {
   EXPECT_EQ(m[3].str(), isa) << m.str();
 }
 
-void expect_runs(const std::string& binary, const std::string& flags, const std::string& header) {
+std::string expect_runs(const std::string& binary, const std::string& flags, const std::string& header) {
   std::string out;
   int rc = run(std::string(PT_BENCH_DIR) + "/" + binary + " --smoke" + flags, out);
   EXPECT_EQ(rc, 0) << out;
   EXPECT_NE(out.find(header), std::string::npos) << "no table header '" << header << "' in:\n" << out;
   expect_host_line(out, binary);
+  return out;
 }
 
 // A ratio column of the benchmarks' tables: "median lo-hi", two decimals each.
@@ -122,10 +123,28 @@ TEST(BenchTarget, VerdictNamesTheWeakestCaseAndCountsMisses) {
 
 TEST(BenchSmoke, Convergence) {
   std::string dir = pt::test::temp_dir() + "/bench_smoke";
-  expect_runs("bench_convergence", " --out " + dir + " --cache " + dir,
-              "scene         m   spp   seconds  samples/s     rays/s rays/spl     relMSE");
+  const std::string out = expect_runs("bench_convergence", " --spp 16 --out " + dir + " --cache " + dir,
+                                      "scene         m   spp   seconds  samples/s     rays/s rays/spl     relMSE");
   EXPECT_TRUE(pt::test::file_exists(dir + "/convergence_dof_m5_sobol.csv"));
   EXPECT_TRUE(pt::test::file_exists(dir + "/convergence_dof_m5_sobol.png"));
+  // Each pass's est/true is the estimate over relMSE less the reference's noise, and the verdict
+  // on the issue's factor 1.5 takes the passes from 16 spp: here the last one.
+  const std::regex pass(R"(\ndof +(\d+) +\S+ +\S+ +(\S+) +\S+ +(\S+) +(\S+) +(\S+) +\S+(?=\n))");
+  double worst = NAN;
+  int passes = 0;
+  for (std::sregex_iterator r(out.begin(), out.end(), pass), end; r != end; ++r, ++passes) {
+    const std::smatch& m = *r;
+    if (m[3] == "inf") continue;  // one sample a pixel: no estimate yet
+    const double rel_mse = std::stod(m[2]), estimate = std::stod(m[3]), floor = std::stod(m[4]);
+    const double ratio = std::stod(m[5]), expected = estimate / (rel_mse - floor);
+    EXPECT_NEAR(ratio, expected, 0.005 + 0.005 * expected) << m.str();
+    if (std::stoi(m[1]) >= 16) worst = std::round(100 * std::min(ratio, 1 / ratio)) / 100;
+  }
+  EXPECT_EQ(passes, 5) << out;  // 1, 2, 4, 8, 16 spp
+  const Verdict v = find_verdict(out, R"(the estimate within 1\.5x of the true error from 16 spp, min\(est/true, true/est\) >= 0\.67)");
+  EXPECT_NEAR(v.lowest, worst, 0.011) << out;  // from the printed ratio, itself rounded
+  EXPECT_EQ(v.where, "dof, 16 spp") << out;
+  EXPECT_EQ(v.met, v.lowest >= 0.67) << out;
 }
 
 TEST(BenchSmoke, Ceiling) {
