@@ -25,9 +25,9 @@ RenderParams small_render(int width, int height, int spp) {
 }
 
 // The estimate against the true error pass by pass (2, 4, ... 256 spp): their ratio as a geometric
-// mean over `seeds` renders, since one small render's true error is itself noisy (one seed's
-// ratio at 16 spp on dof 40x30 ranged 1.0-2.2). The truth is the relMSE against a `ref_spp`
-// render, less that render's own estimated error.
+// mean over `seeds` renders, since one small render's true error is itself noisy (on dof 40x30 one
+// seed's ratio at 16 spp reached 2.2 against a mean of 1.4). The truth is the relMSE against a
+// `ref_spp` render, less that render's own estimated error.
 std::vector<double> estimate_over_truth_by_pass(const SceneDesc& desc, RenderParams p, int ref_spp, int seeds) {
   p.spp = ref_spp;
   p.seed = 99;
