@@ -135,6 +135,7 @@ Vec3 FilmAccumulator::pixel_mean(size_t i) const {
 
 void FilmAccumulator::merge(const FilmPass& pass) {
   if (pass.width != m_w || pass.height != m_h) throw std::runtime_error("film pass of the wrong size");
+  m_estimate.invalidate();
   uint64_t pass_samples = 0;
   for (uint32_t c : pass.samples) pass_samples += c;
   const bool to_half = m_half_samples <= m_other_samples;
@@ -191,8 +192,10 @@ double FilmAccumulator::progress() const {
 
 double FilmAccumulator::error_estimate() const {
   // As the session's, with the two halves made of whole passes.
-  return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
-                               {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths});
+  return m_estimate.get([this] {
+    return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
+                                 {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths});
+  });
 }
 
 ImageRGB FilmAccumulator::image() const {

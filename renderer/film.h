@@ -53,7 +53,7 @@ class FilmAccumulator {
   bool finished() const { return m_remaining == 0; }
   size_t remaining() const { return m_remaining; }  // pixels still taking samples
   double progress() const;
-  double error_estimate() const;
+  double error_estimate() const;  // computed once after each merge
   uint64_t samples() const { return m_samples; }
   uint64_t rays() const { return m_rays; }
   uint64_t nonfinite() const { return m_nonfinite; }
@@ -78,6 +78,7 @@ class FilmAccumulator {
   std::vector<Vec3> m_lt_sum;
   std::vector<double> m_lt_s1, m_lt_half_s1;
   uint64_t m_lt_paths = 0, m_lt_half_paths = 0;
+  CachedEstimate m_estimate;  // error_estimate() of what was merged so far
   Vec3 pixel_mean(size_t i) const;
   uint64_t m_samples = 0, m_rays = 0, m_nonfinite = 0;
 };

@@ -264,6 +264,7 @@ void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) 
 bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel, const TileCallback& on_tile) {
   target_spp = std::min(target_spp, m_params.spp);
   auto start = std::chrono::steady_clock::now();
+  m_estimate.invalidate();
   if (m_params.caustics_light_traced) trace_caustics(target_spp, cancel);
   std::atomic<size_t> next{0};
   auto worker = [&]() {
@@ -290,6 +291,7 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
   worker();
   for (auto& t : pool) t.join();
   order_tiles_by_cost();
+  m_estimate.invalidate();  // also for an estimate someone asked for while the pass ran
   m_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++m_passes;
   return !stop_requested(cancel);
@@ -542,8 +544,10 @@ std::string format_error_estimate(double error) {
 
 double RenderSession::error_estimate() const {
   // P, the first half's size, is the last power of two below n.
-  return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
-                               {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths}, m_params.threads);
+  return m_estimate.get([this] {
+    return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
+                                 {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths}, m_params.threads);
+  });
 }
 
 SessionStats RenderSession::stats() const {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -167,6 +168,43 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
                              const std::vector<double>& s1, const std::vector<double>& half_s1,
                              const SplatStats& splats = {}, int threads = 1);
 
+// The last error estimate of statistics that have not changed since. A render's callers ask
+// again after its last pass (the CLI's summary line and EXR header, the job's final report), and
+// each estimate reads every pixel's statistics and its neighbours'. Whoever changes the
+// statistics calls invalidate(); get() is safe from several threads at once.
+class CachedEstimate {
+ public:
+  CachedEstimate() = default;
+  CachedEstimate(const CachedEstimate& o) : m_valid(o.m_valid), m_value(o.m_value) {}
+  CachedEstimate& operator=(const CachedEstimate& o) {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_valid = o.m_valid;
+    m_value = o.m_value;
+    return *this;
+  }
+  void invalidate() {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_valid = false;
+  }
+  template <class Compute>
+  double get(Compute compute) const {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    if (!m_valid) {
+      m_value = compute();
+      m_valid = true;
+      ++m_computed;
+    }
+    return m_value;
+  }
+  uint64_t times_computed() const { return m_computed; }  // for tests: each estimate is paid once
+
+ private:
+  mutable std::mutex m_mutex;
+  mutable bool m_valid = false;
+  mutable double m_value = 0;
+  mutable uint64_t m_computed = 0;
+};
+
 // A pixel's radiance: the mean of its camera samples plus, where caustics are light traced, its
 // splat sum over every light path traced (caustics.h). The session and the merged film both use it.
 inline Vec3 pixel_estimate(Vec3 sum, uint32_t count, const std::vector<Vec3>& splat_sums, uint64_t light_paths,
@@ -215,8 +253,9 @@ class RenderSession {
   // The light-traced caustics alone (caustics.h), part of image(); black when they are path traced.
   ImageRGB caustic_image() const;
   // Estimated relative MSE of the image, without a reference (see render.cpp); infinite until
-  // some pixel has two samples to compare.
+  // some pixel has two samples to compare. Computed once for the statistics of each pass.
   double error_estimate() const;
+  uint64_t error_estimates_computed() const { return m_estimate.times_computed(); }
   SessionStats stats() const;
   const std::vector<Tile>& tiles() const { return m_tiles; }
   // Mean radiance of a tile's pixels, row by row. Safe inside on_tile for that tile (its worker
@@ -314,6 +353,7 @@ class RenderSession {
   std::atomic<uint64_t> m_cpu_ns{0};      // SessionStats::cpu_seconds
   double m_seconds = 0;
   int m_passes = 0;
+  CachedEstimate m_estimate;  // error_estimate() of the statistics since the last pass
   std::chrono::steady_clock::time_point m_deadline = std::chrono::steady_clock::time_point::max();
   bool stop_requested(const std::atomic<bool>* cancel) const {
     return (cancel && cancel->load(std::memory_order_relaxed)) || std::chrono::steady_clock::now() >= m_deadline;

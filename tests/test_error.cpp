@@ -292,3 +292,42 @@ TEST(NextPassTarget, ARenderStopsNearItsErrorTargetNotADoublingPast) {
   EXPECT_LT(passes.back().target_spp, 128);
   EXPECT_LE(passes.back().error, limits.target_error);
 }
+
+// The estimate is computed once for the statistics of each pass and asked for again at the end of
+// a render (the CLI's summary line and EXR header, a job's final report). A render cut short in
+// the middle of a pass (here a cancel after some tiles of the fourth pass) still reports what its
+// last samples say, and an estimate asked for before a pass is never the one given after it.
+TEST(ErrorEstimateCache, OncePerPassNeverStaleAfterAPassEvenACutOne) {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  RenderParams p = small_render(64, 48, 64);
+  p.threads = 1;  // so that the cancel falls after a known number of tiles
+  auto scene = make_render_scene(desc, p);
+
+  RenderSession cut(*scene, p);
+  ASSERT_GT(cut.tiles().size(), 2u);
+  std::atomic<bool> cancel{false};
+  std::vector<PassReport> passes;
+  size_t tiles = 0;
+  const size_t cancel_at = 3 * cut.tiles().size() + cut.tiles().size() / 2;  // midway through pass 4
+  const StopReason why = run_progressive(cut, {}, &cancel, [&](const Tile&) { if (++tiles == cancel_at) cancel = true; },
+                                         [&](const PassReport& r) { passes.push_back(r); });
+  EXPECT_EQ(why, StopReason::cancelled);
+  ASSERT_EQ(passes.size(), 4u);
+  EXPECT_EQ(cut.error_estimates_computed(), 4u) << "one estimate a pass";
+  EXPECT_EQ(cut.error_estimate(), passes.back().error) << "the last pass's samples, the half-pass included";
+  EXPECT_EQ(cut.error_estimates_computed(), 4u) << "asked again with no new samples: not computed again";
+  EXPECT_NE(passes[2].error, passes[3].error) << "the cut pass added samples, and its estimate saw them";
+
+  // Asked after every pass or only at the end, the same statistics give the same estimate.
+  RenderSession every(*scene, p), once(*scene, p);
+  std::vector<double> each;
+  for (int target : {2, 4, 8}) {
+    every.render_pass(target);
+    each.push_back(every.error_estimate());
+    once.render_pass(target);
+  }
+  EXPECT_EQ(once.error_estimate(), each.back());
+  EXPECT_EQ(once.error_estimates_computed(), 1u);
+  EXPECT_NE(each[0], each[1]);
+  EXPECT_NE(each[1], each[2]);
+}

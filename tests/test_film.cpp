@@ -37,8 +37,17 @@ TEST(Film, DisjointPassesMergeIntoTheSessionImage) {
 
   // Out of order and uneven, as workers return them.
   FilmAccumulator film(f.params, 48, 36);
-  for (auto [first, count] : {std::pair<uint32_t, uint32_t>{8, 8}, {0, 1}, {2, 2}, {1, 1}, {4, 4}})
-    film.merge(render_film_pass(*f.scene, f.params, first, count, {}, nullptr));
+  FilmAccumulator asked_once(f.params, 48, 36);  // the same merges, its estimate asked for only at the end
+  std::vector<double> estimates;
+  for (auto [first, count] : {std::pair<uint32_t, uint32_t>{8, 8}, {0, 1}, {2, 2}, {1, 1}, {4, 4}}) {
+    const FilmPass pass = render_film_pass(*f.scene, f.params, first, count, {}, nullptr);
+    film.merge(pass);
+    asked_once.merge(pass);
+    estimates.push_back(film.error_estimate());
+  }
+  // Each merge's estimate sees its samples (it is computed once per merge, never left stale).
+  for (size_t k = 1; k < estimates.size(); ++k) EXPECT_NE(estimates[k], estimates[k - 1]) << k;
+  EXPECT_EQ(asked_once.error_estimate(), estimates.back());
   EXPECT_TRUE(film.finished());
   EXPECT_EQ(film.samples(), 48u * 36u * 16u);
   EXPECT_DOUBLE_EQ(film.progress(), 1.0);
