@@ -2,7 +2,7 @@
 // (OpenCV, GDAL, FFmpeg, GStreamer, ...), and loading them took 0.35-0.45 s at every process start:
 // `pathtracer --help` spent that long, and so did every test process and the server. So all
 // OpenImageIO code lives in a module, pt_imageio.so (image_oiio.cpp), that image.cpp loads with
-// dlopen on the first read or write, or earlier in the background (preload_image_io).
+// dlopen on the first read or write (not earlier on a thread: see image.cpp).
 #pragma once
 
 #include <cstdint>
