@@ -175,11 +175,10 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
 class CachedEstimate {
  public:
   CachedEstimate() = default;
-  CachedEstimate(const CachedEstimate& o) : m_valid(o.m_valid), m_value(o.m_value) {}
-  CachedEstimate& operator=(const CachedEstimate& o) {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    m_valid = o.m_valid;
-    m_value = o.m_value;
+  // A copy starts empty (its owner's statistics are copied beside it; the next get() computes).
+  CachedEstimate(const CachedEstimate&) {}
+  CachedEstimate& operator=(const CachedEstimate&) {
+    invalidate();
     return *this;
   }
   void invalidate() {
@@ -196,7 +195,10 @@ class CachedEstimate {
     }
     return m_value;
   }
-  uint64_t times_computed() const { return m_computed; }  // for tests: each estimate is paid once
+  uint64_t times_computed() const {  // for tests: each estimate is paid once
+    std::lock_guard<std::mutex> lock(m_mutex);
+    return m_computed;
+  }
 
  private:
   mutable std::mutex m_mutex;
