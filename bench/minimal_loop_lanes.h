@@ -1,0 +1,213 @@
+// The minimal path loop of minimal_loop.h with its own work in AVX2 lanes, eight paths at a time:
+// a measure of how much of that loop's time a ray wide lanes take away while its rays still go
+// through Accel's array interface (Ray and SurfaceHit records, packed into Embree's packets
+// there). The same paths as the scalar loop: a pool of 256, camera rays through the scene's camera
+// (Camera::generate_rays, itself in lanes), one shadow ray a hit to a point on the first light, a
+// cosine-weighted bounce with a constant albedo, at most five hits. Its random numbers are a
+// counter-based hash in lanes (PCG's output permutation of a per-sample key plus a draw index;
+// M. Jarzynski and M. Olano, "Hash Functions for GPU Rendering", JCGT 9(3), 2020) instead of
+// the scalar loop's PCG32 streams, since a 64-bit multiply has no AVX2 lane form.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+#include "minimal_loop.h"
+#include "simd8.h"
+
+namespace bench {
+
+PT_BEGIN_AVX2
+namespace lanes8 {
+using namespace pt::simd8;
+typedef uint32_t vu __attribute__((vector_size(32)));
+constexpr int kW = 8;
+
+inline vu hash(vu x) {
+  const vu state = x * 747796405u + 2891336453u;
+  const vu word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+inline vf unit(vu h) { return __builtin_convertvector(vi(h >> 8u), vf) * splat(0x1p-24f); }
+inline vu loadu32(const uint32_t* p) { return *reinterpret_cast<const vu*>(p); }
+
+// offset_ray_origin (accel.h) in lanes, as diffuse_lanes_body.inc has it.
+inline vf offset_coordinate(vf p, vf n) {
+  constexpr float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
+  vi of = truncate(splat(int_scale) * n);
+  vi bits = vi(p) + ((p < 0) ? -of : of);
+  return sel(fabs(p) < origin, p + splat(float_scale) * n, vf(bits));
+}
+inline V3 offset_origin(V3 p, V3 n) {
+  return {offset_coordinate(p.x, n.x), offset_coordinate(p.y, n.y), offset_coordinate(p.z, n.z)};
+}
+
+constexpr size_t kPool = 256, kPad = kPool + kW;
+
+// The hits of one step, gathered from SurfaceHit records into lanes.
+struct HitLanes {
+  alignas(32) float px[kPad], py[kPad], pz[kPad], gx[kPad], gy[kPad], gz[kPad], nx[kPad], ny[kPad], nz[kPad];
+  alignas(32) float off[kPad], dx[kPad], dy[kPad], dz[kPad];
+  alignas(32) uint32_t key[kPad], draw[kPad];
+  // Out: the bounce ray's origin and direction.
+  alignas(32) float ox[kPad], oy[kPad], oz[kPad], wx[kPad], wy[kPad], wz[kPad];
+};
+
+inline MinimalLoopResult pass(const pt::RenderScene& scene, const std::vector<int>& pixels, int w, int h, int spp) {
+  using namespace pt;
+  constexpr int kHits = 5;
+  constexpr float kAlbedo = 0.6f;
+  const Accel& accel = *scene.accel;
+  std::vector<Ray> rays(kPad), shadow(kPad);
+  std::vector<SurfaceHit> hits(kPool);
+  std::vector<uint8_t> found(kPool), blocked(kPool);
+  std::vector<float> beta(kPool), film(size_t(w) * size_t(h), 0.0f);
+  std::vector<int> depth(kPool), pixel(kPool);
+  std::vector<uint32_t> key(kPool), draws(kPool), slot(kPad);
+  static thread_local HitLanes v;
+  alignas(32) float sx[kPad], sy[kPad];
+  alignas(32) uint32_t new_key[kPad];
+  Vec2 lens[kPad];
+  const Light* light = scene.lights.empty() ? nullptr : &scene.lights[0];
+  const bool aimed = light && !light->is_infinite();
+  const V3 l_pos = broadcast(aimed ? light->position : Vec3(0.0f)), l_dx = broadcast(aimed ? light->dim_x : Vec3(0.0f)),
+           l_dy = broadcast(aimed ? light->dim_y : Vec3(0.0f));
+  const vf half = splat(0.5f), one = splat(1.0f);
+
+  const uint64_t n_pixels = pixels.size(), total = n_pixels * uint64_t(spp);
+  uint64_t next = 0;
+  MinimalLoopResult r;
+  size_t live = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (;;) {
+    // Refill: keys, sensor points and lens draws in lanes, then the camera's own lanes.
+    const size_t first_new = live;
+    size_t fresh = 0;
+    for (; live < kPool && next < total; ++next, ++live, ++fresh) {
+      pixel[live] = pixels[size_t(next % n_pixels)];
+      new_key[fresh] = uint32_t(pixel[live]) * 0x9E3779B9u ^ uint32_t(next / n_pixels) * 0x85EBCA6Bu;
+    }
+    for (size_t i = 0; i < fresh; i += kW) {
+      const vu k = hash(loadu32(new_key + i));
+      const vu base = k * 4u;  // draws 0-3 of the sample: the jitter, then the lens
+      vf px, py;
+      for (int j = 0; j < kW; ++j) {
+        const int p = pixel[std::min(first_new + i + j, kPool - 1)];
+        px[j] = float(p % w);
+        py[j] = float(p / w);
+      }
+      store(sx + i, (px + unit(hash(base))) / splat(float(w)));
+      store(sy + i, one - (py + unit(hash(base + 1u))) / splat(float(h)));
+      const vf lx = unit(hash(base + 2u)), ly = unit(hash(base + 3u));
+      for (int j = 0; j < kW; ++j) lens[i + j] = Vec2{lx[j], ly[j]};
+      for (int j = 0; j < kW && i + j < fresh; ++j) {
+        key[first_new + i + j] = k[j];
+        draws[first_new + i + j] = 4;
+      }
+    }
+    if (fresh) scene.camera.generate_rays(sx, sy, lens, fresh, &rays[first_new]);
+    for (size_t i = first_new; i < live; ++i) beta[i] = 1, depth[i] = 0;
+    if (live == 0) break;
+
+    accel.intersect_many(rays.data(), live, hits.data(), found.data());
+    size_t n = 0;  // the hits, gathered into lanes
+    for (size_t i = 0; i < live; ++i) {
+      if (!found[i]) continue;
+      const SurfaceHit& s = hits[i];
+      v.px[n] = s.p.x, v.py[n] = s.p.y, v.pz[n] = s.p.z;
+      v.gx[n] = s.ng.x, v.gy[n] = s.ng.y, v.gz[n] = s.ng.z;
+      v.nx[n] = s.ns.x, v.ny[n] = s.ns.y, v.nz[n] = s.ns.z;
+      v.off[n] = s.offset;
+      v.dx[n] = rays[i].d.x, v.dy[n] = rays[i].d.y, v.dz[n] = rays[i].d.z;
+      v.key[n] = key[i];
+      v.draw[n] = draws[i];
+      slot[n++] = uint32_t(i);
+    }
+    for (size_t i = n; i < (n + kW - 1) / kW * kW; ++i) {  // the last group's spare lanes: finite values
+      v.px[i] = v.py[i] = v.pz[i] = v.gx[i] = v.gy[i] = v.nx[i] = v.ny[i] = v.off[i] = v.dx[i] = v.dy[i] = 0;
+      v.gz[i] = v.nz[i] = v.dz[i] = 1;
+      v.key[i] = v.draw[i] = 0;
+    }
+    for (size_t i = 0; i < n; i += kW) {
+      const vu base = loadu32(v.key + i) * 4u + loadu32(v.draw + i);
+      const V3 p = load3(v.px, v.py, v.pz, int(i)), g = load3(v.gx, v.gy, v.gz, int(i));
+      const V3 ns = load3(v.nx, v.ny, v.nz, int(i)), d = load3(v.dx, v.dy, v.dz, int(i));
+      const vf off = load(v.off + i);
+      // The shadow ray: spawn_ray_to a point on the light, or along the facing normal.
+      const vf ux = unit(hash(base)), uy = unit(hash(base + 1u));
+      const vi facing = dot(d, ns) < 0;
+      const V3 n_face = sel(facing, ns, neg(ns));
+      V3 so, sd;
+      vf stmax;
+      if (aimed) {
+        const V3 q = add(add(l_pos, mul(l_dx, ux - half)), mul(l_dy, uy - half));
+        const V3 side = sel(dot(sub(q, p), g) >= 0, g, neg(g));
+        so = offset_origin(add(p, mul(side, off)), side);
+        sd = sub(q, so);
+        stmax = splat(kShadowRayEnd);
+      } else {
+        const V3 side = sel(dot(n_face, g) >= 0, g, neg(g));
+        so = offset_origin(add(p, mul(side, off)), side);
+        sd = n_face;
+        stmax = splat(kInf);
+      }
+      for (int j = 0; j < kW; ++j) {
+        Ray& s = shadow[i + j];
+        s.o = Vec3(so.x[j], so.y[j], so.z[j]);
+        s.d = Vec3(sd.x[j], sd.y[j], sd.z[j]);
+        s.tmin = 0;
+        s.tmax = stmax[j];
+      }
+      // The bounce: Frame(n_face) (Duff et al. 2017), a cosine-weighted direction, spawn_ray.
+      const vf sign = vf((vi(n_face.z) & int32_t(0x80000000)) | vi(one));
+      const vf a = splat(-1.0f) / (sign + n_face.z), b = n_face.x * n_face.y * a;
+      const V3 s_axis{one + sign * n_face.x * n_face.x * a, sign * b, -sign * n_face.x};
+      const V3 t_axis{b, sign + n_face.y * n_face.y * a, -n_face.y};
+      vf x, y;
+      concentric_disk(unit(hash(base + 2u)), unit(hash(base + 3u)), x, y);
+      const vf z = sqrt(max0(one - x * x - y * y));
+      const V3 wi = add(add(mul(s_axis, x), mul(t_axis, y)), mul(n_face, z));
+      const V3 side = sel(dot(wi, g) >= 0, g, neg(g));
+      store3(v.ox, v.oy, v.oz, int(i), offset_origin(add(p, mul(side, off)), side));
+      store3(v.wx, v.wy, v.wz, int(i), wi);
+    }
+    accel.occluded_many(shadow.data(), n, blocked.data());
+    r.rays += live + n;
+    size_t kept = 0;  // the paths that go on, packed to the front of the pool
+    for (size_t k = 0; k < n; ++k) {
+      const size_t i = slot[k];
+      if (!blocked[k]) film[size_t(pixel[i])] += beta[i];
+      if (++depth[i] >= kHits) continue;
+      if (hits[i].light >= 0) film[size_t(pixel[i])] += beta[i];
+      Ray& next_ray = rays[kept];
+      next_ray.o = Vec3(v.ox[k], v.oy[k], v.oz[k]);
+      next_ray.d = Vec3(v.wx[k], v.wy[k], v.wz[k]);
+      next_ray.tmin = 0;
+      next_ray.tmax = kInf;
+      beta[kept] = beta[i] * kAlbedo;
+      depth[kept] = depth[i];
+      pixel[kept] = pixel[i];
+      key[kept] = key[i];
+      draws[kept] = draws[i] + 4;
+      ++kept;
+    }
+    live = kept;
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (float f : film) r.radiance += double(f);
+  return r;
+}
+
+}  // namespace lanes8
+PT_END_AVX2
+
+// The lanes loop where the CPU has AVX2 (it has no SSE2 form); false elsewhere.
+inline bool minimal_loop_lanes_pass(const pt::RenderScene& scene, const std::vector<int>& pixels, int w, int h, int spp,
+                                    MinimalLoopResult& out) {
+  if (!pt::simd::use_avx2()) return false;
+  out = lanes8::pass(scene, pixels, w, h, spp);
+  return true;
+}
+
+}  // namespace bench
