@@ -10,8 +10,8 @@
 // would take if nothing else cost anything. Beside it, with one thread, the same ratio for a
 // minimal path loop on the same pixels (bench/minimal_loop.h): what a loop that keeps only its rays
 // reaches against the raw replay of those rays; and the same loop with its own work in AVX2 lanes
-// (bench/minimal_loop_lanes.h): how much of that a wide integrator takes back while its rays still
-// go through Accel's Ray and SurfaceHit records.
+// (bench/minimal_loop_lanes.h), its rays once through Accel's Ray and SurfaceHit records and once
+// kept in Embree's packet layout: what an integrator rewritten in lanes could reach.
 //
 //   bench_ceiling [--spp 16] [--runs 5] [--threads N] [--scene NAME] [--sampler sobol|independent] [--smoke]
 #include <algorithm>
@@ -98,13 +98,13 @@ int bench_main(int argc, char** argv) {
   std::printf("bench_ceiling: rays of one %d-spp pass at %s (keep_fov, m = 5, light_samples 1, no adaptive), "
               "%s sampler, replayed; rays/s are medians of %d runs\n",
               spp, smoke ? "64x48" : "480x360", sampler_name(sampler), runs);
-  std::vector<std::string> table, split, minimal;
+  std::vector<std::string> table, split, minimal, lanes_table;
   TargetCheck target("PT/raw >= 0.70 on every scene, with 1 and " + std::to_string(many) + " threads", 0.70, smoke);
   int packet_width = 0;  // Accel's, the same for every scene (Embree's native width)
   ProgressBar bar("bench_ceiling");
   int done = 0;
   const bool lanes_loop = simd::use_avx2();
-  const int total = int(scenes.size()) * (2 * 7 + 2 + (lanes_loop ? 2 : 0)) * runs;
+  const int total = int(scenes.size()) * (2 * 7 + 2 + (lanes_loop ? 4 : 0)) * runs;
   for (BenchScene sc : scenes) {
     sc.max_depth = 5;
     SceneDesc desc = load_collada(sc.path);
@@ -151,17 +151,25 @@ int bench_main(int argc, char** argv) {
     std::vector<double> minimal_ratio;
     AccelTimer minimal_timer;
     uint64_t minimal_ticks = 0, minimal_rays = 0;
-    // The lanes loop's rays: the same paths with other random numbers, so about as many.
-    RayRecorder lanes_rec;
-    MinimalLoopResult lanes_result;
-    if (lanes_loop) {
-      record_rays_on_this_thread(&lanes_rec);
-      minimal_loop_lanes_pass(*scene, pixels, p.width, p.height, spp, lanes_result);
+    // The lanes loops' rays (records, then in place): the same paths with other random numbers.
+    struct LanesLoop {
+      bool in_place = false;
+      RayRecorder rec;
+      double radiance = 0;
+      std::vector<double> ratio;
+      AccelTimer timer;
+      uint64_t ticks = 0, rays = 0;
+    };
+    LanesLoop lanes_loops[2];
+    lanes_loops[1].in_place = true;
+    for (LanesLoop& l : lanes_loops) {
+      if (!lanes_loop) break;
+      MinimalLoopResult result;
+      record_rays_on_this_thread(&l.rec);
+      minimal_loop_lanes_pass(*scene, pixels, p.width, p.height, spp, result, l.in_place);
       record_rays_on_this_thread(nullptr);
+      l.radiance = result.radiance;
     }
-    std::vector<double> lanes_ratio;
-    AccelTimer lanes_timer;
-    uint64_t lanes_ticks = 0, lanes_rays = 0;
     double pt_rest_per_ray = 0;
     for (Mode m : {Mode::accel, Mode::accel_many, Mode::raw, Mode::stream, Mode::packet16, Mode::packet8})
       replay_rate(accel, rec, 1, m, batch);  // warm up
@@ -213,18 +221,19 @@ int bench_main(int argc, char** argv) {
           const double raw_rate = replay_rate(accel, minimal_rec, 1, packet_width == 16 ? Mode::packet16 : Mode::packet8, batch);
           bar.update(double(++done) / total);
           minimal_ratio.push_back((double(loop.rays) / loop.seconds) / raw_rate);
-          if (lanes_loop) {
+          for (LanesLoop& l : lanes_loops) {
+            if (!lanes_loop) break;
             MinimalLoopResult lanes;
-            time_accel_on_this_thread(&lanes_timer);
+            time_accel_on_this_thread(&l.timer);
             const uint64_t l0 = accel_ticks();
-            minimal_loop_lanes_pass(*scene, pixels, p.width, p.height, spp, lanes);
-            lanes_ticks += accel_ticks() - l0;
+            minimal_loop_lanes_pass(*scene, pixels, p.width, p.height, spp, lanes, l.in_place);
+            l.ticks += accel_ticks() - l0;
             time_accel_on_this_thread(nullptr);
-            lanes_rays += lanes.rays;
+            l.rays += lanes.rays;
             bar.update(double(++done) / total);
-            const double lanes_raw = replay_rate(accel, lanes_rec, 1, packet_width == 16 ? Mode::packet16 : Mode::packet8, batch);
+            const double lanes_raw = replay_rate(accel, l.rec, 1, packet_width == 16 ? Mode::packet16 : Mode::packet8, batch);
             bar.update(double(++done) / total);
-            lanes_ratio.push_back((double(lanes.rays) / lanes.seconds) / lanes_raw);
+            l.ratio.push_back((double(lanes.rays) / lanes.seconds) / lanes_raw);
           }
         }
       }
@@ -270,16 +279,18 @@ int bench_main(int argc, char** argv) {
         std::snprintf(row, sizeof row, "%-10s %8.2f M %7.1f%% %10.2f %4.2f-%4.2f %9.1f %9.1f %11.2f", sc.name.c_str(),
                       minimal_rec.rays.size() / 1e6, 100.0 * minimal_shadows / std::max<size_t>(1, minimal_rec.rays.size()),
                       median(minimal_ratio), *lo_m, *hi_m, rest, pt_rest_per_ray, median(paired_raw) / median(minimal_ratio));
-        std::string line = row;
-        if (lanes_loop) {
-          const auto [lo_l, hi_l] = std::minmax_element(lanes_ratio.begin(), lanes_ratio.end());
-          const double lanes_rest = double(lanes_ticks - lanes_timer.embree - lanes_timer.refine) / double(lanes_rays);
-          std::snprintf(row, sizeof row, " %10.2f %4.2f-%4.2f %10.1f %10.4f", median(lanes_ratio), *lo_l, *hi_l, lanes_rest,
-                        lanes_result.radiance / std::max(1e-30, minimal_radiance));
-        } else {
-          std::snprintf(row, sizeof row, " %10s %9s %10s %10s", "n/a", "", "n/a", "n/a");
+        minimal.push_back(row);
+        std::string line = sc.name;
+        line.resize(10, ' ');
+        for (const LanesLoop& l : lanes_loops) {
+          if (!lanes_loop) break;
+          const auto [lo_l, hi_l] = std::minmax_element(l.ratio.begin(), l.ratio.end());
+          const double lanes_rest = double(l.ticks - l.timer.embree - l.timer.refine) / double(l.rays);
+          std::snprintf(row, sizeof row, " %12.2f %4.2f-%4.2f %9.1f %10.4f", median(l.ratio), *lo_l, *hi_l, lanes_rest,
+                        l.radiance / std::max(1e-30, minimal_radiance));
+          line += row;
         }
-        minimal.push_back(line + row);
+        if (lanes_loop) lanes_table.push_back(line);
       }
     }
   }
@@ -308,17 +319,25 @@ int bench_main(int argc, char** argv) {
 #else
               "nanoseconds");
 #endif
-  std::printf("\nA minimal path loop on the same pixels, one thread (bench/minimal_loop.h, and in lanes: minimal_loop_lanes.h):\n"
-              "%-10s %10s %8s %10s %9s %9s %9s %11s %10s %9s %10s %10s\n",
-              "scene", "rays", "shadow", "loop/raw", "min-max", "rest/ray", "PT rest", "PT/loop", "lanes/raw", "min-max",
-              "lanes rest", "lanes/loop");
+  std::printf("\nA minimal path loop on the same pixels, one thread (bench/minimal_loop.h):\n%-10s %10s %8s %10s %9s %9s %9s %11s\n",
+              "scene", "rays", "shadow", "loop/raw", "min-max", "rest/ray", "PT rest", "PT/loop");
   for (const std::string& l : minimal) std::printf("%s\n", l.c_str());
   std::printf("loop/raw = the minimal loop's rays/s over the raw replay of its own rays (packets of %d), median of the runs "
               "(min-max); rest/ray = its own time a ray, PT rest = the path tracer's (above); PT/loop = PT/raw (1 thread) over "
-              "loop/raw: how near the path tracer comes to a loop that keeps only its rays; lanes/raw and lanes rest = the "
-              "same for that loop with its own work in AVX2 lanes (n/a without AVX2), lanes/loop = its light gathered over the "
-              "scalar loop's (the same paths with other random numbers: about 1)\n",
+              "loop/raw: how near the path tracer comes to a loop that keeps only its rays\n",
               packet_width);
+  if (!lanes_loop) {
+    std::printf("\nThe minimal loop in lanes: not run (it needs AVX2)\n");
+    return 0;
+  }
+  std::printf("\nThe same loop with its own work in AVX2 lanes, one thread (bench/minimal_loop_lanes.h):\n%-10s %12s %9s %9s %10s "
+              "%12s %9s %9s %10s\n",
+              "scene", "records/raw", "min-max", "rest/ray", "light", "in place/raw", "min-max", "rest/ray", "light");
+  for (const std::string& l : lanes_table) std::printf("%s\n", l.c_str());
+  std::printf("records = its rays through Accel::intersect_many / occluded_many (Ray and SurfaceHit records, packed into "
+              "packets there); in place = its rays kept in Embree's packet layout (Accel::intersect16 / occluded16, no "
+              "packing, hits read in lanes); /raw and rest/ray as above, each against the raw replay of its own rays; light = "
+              "what it gathered over the scalar loop's (the same paths with other random numbers: about 1)\n");
   return 0;
 }
 

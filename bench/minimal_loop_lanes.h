@@ -199,14 +199,183 @@ inline MinimalLoopResult pass(const pt::RenderScene& scene, const std::vector<in
   return r;
 }
 
+// The same loop with its rays where Embree reads them (Accel::RayPacket16: no packing) and its hits
+// read in lanes (the point from t, the unit normal from Embree's; no shading normal, no material):
+// each slot takes a new camera sample where its path ends, so packets stay full without moving
+// paths between slots. The frame is the geometric normal's: on curved meshes its paths differ from
+// the scalar loop's, which turns its shading normals.
+inline MinimalLoopResult pass_in_place(const pt::RenderScene& scene, const std::vector<int>& pixels, int w, int h,
+                                       int spp) {
+  using namespace pt;
+  using Packet = Accel::RayPacket16;
+  constexpr int kHits = 5;
+  constexpr size_t kPackets = kPool / 16;
+  const Accel& accel = *scene.accel;
+  const Camera& cam = scene.camera;
+  std::vector<Packet> rays(kPackets), shadow(kPackets);
+  struct alignas(64) Slots {  // Embree reads valid masks 64-byte aligned
+    float beta[kPool];
+    int depth[kPool], pixel[kPool], valid[kPool], svalid[kPool], fresh[kPool];
+    uint32_t key[kPool], draw[kPool];
+    float px[kPool], py[kPool];
+  };
+  static thread_local Slots sl;
+  std::vector<float> film(size_t(w) * size_t(h), 0.0f);
+  const Light* light = scene.lights.empty() ? nullptr : &scene.lights[0];
+  const bool aimed = light && !light->is_infinite();
+  const V3 l_pos = broadcast(aimed ? light->position : Vec3(0.0f)), l_dx = broadcast(aimed ? light->dim_x : Vec3(0.0f)),
+           l_dy = broadcast(aimed ? light->dim_y : Vec3(0.0f));
+  const vf half = splat(0.5f), one = splat(1.0f), albedo = splat(0.6f), inf = splat(kInf);
+  const V3 c_pos = broadcast(cam.position), c_right = broadcast(cam.right), c_up = broadcast(cam.up),
+           c_back = broadcast(cam.back);
+  for (Packet& pk : rays)
+    for (int k = 0; k < 16; ++k) pk.mask[k] = ~0u, pk.id[k] = 0, pk.flags[k] = 0, pk.time[k] = 0;
+  shadow = rays;
+  for (size_t i = 0; i < kPool; ++i) sl.valid[i] = 0, sl.depth[i] = kHits;
+
+  const uint64_t n_pixels = pixels.size(), total = n_pixels * uint64_t(spp);
+  uint64_t next = 0;
+  MinimalLoopResult r;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (;;) {
+    // Slots whose path ended take the next sample.
+    size_t live = 0;
+    for (size_t i = 0; i < kPool; ++i) {
+      sl.fresh[i] = 0;
+      if (sl.depth[i] >= kHits || !sl.valid[i]) {
+        if (next < total) {
+          const int pix = pixels[size_t(next % n_pixels)];
+          sl.pixel[i] = pix;
+          sl.key[i] = uint32_t(pix) * 0x9E3779B9u ^ uint32_t(next / n_pixels) * 0x85EBCA6Bu;
+          sl.px[i] = float(pix % w);
+          sl.py[i] = float(pix / w);
+          sl.fresh[i] = -1;
+          sl.valid[i] = -1;
+          ++next;
+        } else {
+          sl.valid[i] = 0;
+        }
+      }
+      live += sl.valid[i] != 0;
+    }
+    if (live == 0) break;
+    // Camera rays for the fresh slots, in lanes, blended into the packets.
+    for (size_t c = 0; c < kPool; c += kW) {
+      const vi fresh = *reinterpret_cast<const vi*>(sl.fresh + c);
+      if (!_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(fresh)))) continue;
+      Packet& pk = rays[c / 16];
+      const size_t o = c % 16;
+      const vu k = hash(loadu32(sl.key + c)), base = k * 4u;
+      const vf sx = (load(sl.px + c) + unit(hash(base))) / splat(float(w));
+      const vf sy = one - (load(sl.py + c) + unit(hash(base + 1u))) / splat(float(h));
+      V3 dc{(splat(2.0f) * sx - one) * splat(cam.tan_half_w), (splat(2.0f) * sy - one) * splat(cam.tan_half_h), splat(-1.0f)};
+      V3 org = c_pos;
+      if (cam.lens_radius > 0) {
+        vf lx, ly;
+        concentric_disk(unit(hash(base + 2u)), unit(hash(base + 3u)), lx, ly);
+        lx = lx * splat(cam.lens_radius);
+        ly = ly * splat(cam.lens_radius);
+        const vf f = splat(cam.focal_distance);
+        V3 dir{dc.x * f - lx, dc.y * f - ly, dc.z * f};
+        dc = sel(dot(dir, dir) > 0, dir, dc);
+        org = add(add(c_pos, mul(c_right, lx)), mul(c_up, ly));
+      }
+      const V3 d = normalize(add(add(mul(c_right, dc.x), mul(c_up, dc.y)), mul(c_back, dc.z)));
+      store(pk.ox + o, sel(fresh, org.x, load(pk.ox + o)));
+      store(pk.oy + o, sel(fresh, org.y, load(pk.oy + o)));
+      store(pk.oz + o, sel(fresh, org.z, load(pk.oz + o)));
+      store(pk.dx + o, sel(fresh, d.x, load(pk.dx + o)));
+      store(pk.dy + o, sel(fresh, d.y, load(pk.dy + o)));
+      store(pk.dz + o, sel(fresh, d.z, load(pk.dz + o)));
+      store(sl.beta + c, sel(fresh, one, load(sl.beta + c)));
+      storei(sl.depth + c, fresh ? vi{} : *reinterpret_cast<const vi*>(sl.depth + c));
+      *reinterpret_cast<vu*>(sl.key + c) = vu(fresh ? vi(k) : vi(loadu32(sl.key + c)));
+      *reinterpret_cast<vu*>(sl.draw + c) = vu(fresh ? vi{} + 4 : vi(loadu32(sl.draw + c)));
+    }
+    for (size_t b = 0; b < kPackets; ++b) {
+      Packet& pk = rays[b];
+      for (int k = 0; k < 16; ++k) pk.tnear[k] = 0, pk.tfar[k] = kInf, pk.geom[k] = ~0u, pk.inst[k] = ~0u;
+      accel.intersect16(sl.valid + 16 * b, pk);
+    }
+    // Every hit: the shadow ray and the bounce, in lanes, straight into the packets.
+    size_t n_shadow = 0;
+    for (size_t c = 0; c < kPool; c += kW) {
+      Packet& pk = rays[c / 16];
+      Packet& sp = shadow[c / 16];
+      const size_t o = c % 16;
+      const vi hit = *reinterpret_cast<const vi*>(sl.valid + c) & (vi(loadu32(pk.geom + o)) != vi{} - 1);
+      storei(sl.svalid + c, hit);
+      const vf t = sel(hit, load(pk.tfar + o), vf{});  // lanes without a hit keep finite rays
+      const V3 d = load3(pk.dx, pk.dy, pk.dz, int(o));
+      const V3 p = add(load3(pk.ox, pk.oy, pk.oz, int(o)), mul(d, t));
+      const V3 g = normalize(load3(pk.ngx, pk.ngy, pk.ngz, int(o)));
+      const vu base = loadu32(sl.key + c) * 4u + loadu32(sl.draw + c);
+      const V3 n_face = sel(dot(d, g) < 0, g, neg(g));
+      V3 so, sd;
+      vf stmax;
+      if (aimed) {
+        const V3 q = add(add(l_pos, mul(l_dx, unit(hash(base)) - half)), mul(l_dy, unit(hash(base + 1u)) - half));
+        const V3 side = sel(dot(sub(q, p), g) >= 0, g, neg(g));
+        so = offset_origin(p, side);
+        sd = sub(q, so);
+        stmax = splat(kShadowRayEnd);
+      } else {
+        so = offset_origin(p, n_face);
+        sd = n_face;
+        stmax = inf;
+      }
+      store3(sp.ox + o, sp.oy + o, sp.oz + o, 0, so);
+      store3(sp.dx + o, sp.dy + o, sp.dz + o, 0, sd);
+      store(sp.tnear + o, vf{});
+      store(sp.tfar + o, stmax);
+      const vf sign = vf((vi(n_face.z) & int32_t(0x80000000)) | vi(one));
+      const vf a = splat(-1.0f) / (sign + n_face.z), b = n_face.x * n_face.y * a;
+      const V3 s_axis{one + sign * n_face.x * n_face.x * a, sign * b, -sign * n_face.x};
+      const V3 t_axis{b, sign + n_face.y * n_face.y * a, -n_face.y};
+      vf x, y;
+      concentric_disk(unit(hash(base + 2u)), unit(hash(base + 3u)), x, y);
+      const vf z = sqrt(max0(one - x * x - y * y));
+      const V3 wi = add(add(mul(s_axis, x), mul(t_axis, y)), mul(n_face, z));
+      const V3 no = offset_origin(p, n_face);
+      // Rays of lanes without a hit keep their (finite) old values: their slot restarts.
+      store3(pk.ox + o, pk.oy + o, pk.oz + o, 0, sel(hit, no, load3(pk.ox, pk.oy, pk.oz, int(o))));
+      store3(pk.dx + o, pk.dy + o, pk.dz + o, 0, sel(hit, wi, d));
+      const vi depth = *reinterpret_cast<const vi*>(sl.depth + c) + 1;
+      storei(sl.depth + c, hit ? depth : vi{} + kHits);
+      // Paths that go on gather an emitter's light where they hit one (as the scalar loop does).
+      for (int m = _mm256_movemask_ps(_mm256_castsi256_ps(__m256i(hit & (depth < kHits)))); m; m &= m - 1) {
+        const size_t i = c + size_t(__builtin_ctz(unsigned(m)));
+        if (accel.light_at(pk.geom[i % 16], pk.prim[i % 16]) >= 0) film[size_t(sl.pixel[i])] += sl.beta[i];
+      }
+      *reinterpret_cast<vu*>(sl.draw + c) = loadu32(sl.draw + c) + 4u;
+      n_shadow += size_t(__builtin_popcount(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(hit)))));
+    }
+    for (size_t b = 0; b < kPackets; ++b) accel.occluded16(sl.svalid + 16 * b, shadow[b]);
+    r.rays += live + n_shadow;
+    for (size_t c = 0; c < kPool; c += kW) {  // unblocked shadow rays bring light; throughput falls
+      const Packet& sp = shadow[c / 16];
+      const size_t o = c % 16;
+      const vf beta = load(sl.beta + c);
+      const int lit = _mm256_movemask_ps(_mm256_castsi256_ps(
+          __m256i(*reinterpret_cast<const vi*>(sl.svalid + c) & (load(sp.tfar + o) >= 0))));
+      for (int m = lit; m; m &= m - 1) film[size_t(sl.pixel[c + size_t(__builtin_ctz(unsigned(m)))])] += beta[__builtin_ctz(unsigned(m))];
+      store(sl.beta + c, beta * albedo);
+    }
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (float f : film) r.radiance += double(f);
+  return r;
+}
+
 }  // namespace lanes8
 PT_END_AVX2
 
-// The lanes loop where the CPU has AVX2 (it has no SSE2 form); false elsewhere.
+// The lanes loop where the CPU has AVX2 (it has no SSE2 form); false elsewhere. `in_place`: its rays
+// in Embree's packet layout (pass_in_place) instead of Accel's records.
 inline bool minimal_loop_lanes_pass(const pt::RenderScene& scene, const std::vector<int>& pixels, int w, int h, int spp,
-                                    MinimalLoopResult& out) {
+                                    MinimalLoopResult& out, bool in_place = false) {
   if (!pt::simd::use_avx2()) return false;
-  out = lanes8::pass(scene, pixels, w, h, spp);
+  out = in_place ? lanes8::pass_in_place(scene, pixels, w, h, spp) : lanes8::pass(scene, pixels, w, h, spp);
   return true;
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -547,6 +548,48 @@ size_t cast_packets(RTCScene scene, RTCIntersectContext& ctx, const Ray* rays, c
 }
 
 }  // namespace
+
+// RayPacket16 is RTCRayHit16 field for field (accel.h cannot include Embree).
+static_assert(sizeof(Accel::RayPacket16) == sizeof(RTCRayHit16) && alignof(Accel::RayPacket16) >= 16);
+static_assert(offsetof(Accel::RayPacket16, tfar) == offsetof(RTCRayHit16, ray.tfar));
+static_assert(offsetof(Accel::RayPacket16, flags) == offsetof(RTCRayHit16, ray.flags));
+static_assert(offsetof(Accel::RayPacket16, ngx) == offsetof(RTCRayHit16, hit.Ng_x));
+static_assert(offsetof(Accel::RayPacket16, geom) == offsetof(RTCRayHit16, hit.geomID));
+static_assert(offsetof(Accel::RayPacket16, inst) == offsetof(RTCRayHit16, hit.instID));
+
+namespace {
+void record_packet16(const int* valid, const Accel::RayPacket16& r, uint8_t shadow) {
+  if (__builtin_expect(probe::t_recorder == nullptr, 1)) return;
+  for (int k = 0; k < 16; ++k)
+    if (valid[k]) {
+      Ray ray;
+      ray.o = Vec3(r.ox[k], r.oy[k], r.oz[k]);
+      ray.d = Vec3(r.dx[k], r.dy[k], r.dz[k]);
+      ray.tmin = r.tnear[k];
+      ray.tmax = r.tfar[k];
+      probe::append_ray(ray, shadow);
+    }
+}
+}  // namespace
+
+void Accel::intersect16(const int* valid, RayPacket16& r) const {
+  record_packet16(valid, r, 0);
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  intersect_packet<16>(valid, m_impl->scene, &ctx, reinterpret_cast<RTCRayHit16*>(&r));
+}
+
+void Accel::occluded16(const int* valid, RayPacket16& r) const {
+  record_packet16(valid, r, 1);
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  occluded_packet<16>(valid, m_impl->scene, &ctx, reinterpret_cast<RTCRay16*>(&r));
+}
+
+int Accel::light_at(uint32_t geom, uint32_t prim) const {
+  const GeomInfo& g = m_impl->geoms[geom];
+  return g.kind == GeomKind::spheres ? -1 : g.tris[prim].light;
+}
 
 size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode mode, size_t batch) const {
   RTCIntersectContext ctx;

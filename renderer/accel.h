@@ -76,6 +76,23 @@ class Accel {
   enum class RawMode { single, stream, packet16, packet8 };
   size_t cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode mode, size_t batch) const;
 
+  // Benchmarks only (bench/minimal_loop_lanes.h; the renderer never calls them): 16 rays kept in
+  // Embree's own packet layout (RTCRayHit16's fields in order), traced where they lie, with no
+  // packing and no hit refinement: what an integrator whose rays live in lanes would call. Lanes
+  // whose valid[k] is 0 are left as they are. intersect16 leaves t in tfar, geom[k] != ~0u where a
+  // lane hit and Embree's unnormalised geometric normal in ng*; occluded16 (which reads only the
+  // ray fields) sets tfar < 0 where a lane is blocked. Recorded and timed like every query.
+  struct RayPacket16 {
+    alignas(64) float ox[16], oy[16], oz[16], tnear[16], dx[16], dy[16], dz[16], time[16], tfar[16];
+    uint32_t mask[16], id[16], flags[16];
+    float ngx[16], ngy[16], ngz[16], u[16], v[16];
+    uint32_t prim[16], geom[16], inst[16];
+  };
+  void intersect16(const int* valid, RayPacket16& r) const;
+  void occluded16(const int* valid, RayPacket16& r) const;
+  // The light index of what intersect16 hit (geom[k], prim[k]): >= 0 on an emitter, else -1.
+  int light_at(uint32_t geom, uint32_t prim) const;
+
   struct Impl;
 
  private:
