@@ -1,9 +1,9 @@
 // The minimal path loop of minimal_loop.h with its own work in AVX2 lanes, eight paths at a time:
-// a measure of how much of that loop's time a ray wide lanes take away while its rays still go
-// through Accel's array interface (Ray and SurfaceHit records, packed into Embree's packets
-// there). The same paths as the scalar loop: a pool of 256, camera rays through the scene's camera
-// (Camera::generate_rays, itself in lanes), one shadow ray a hit to a point on the first light, a
-// cosine-weighted bounce with a constant albedo, at most five hits. Its random numbers are a
+// a measure of how much of that loop's time a ray wide lanes take away, with its rays going
+// through Accel's array interface (Ray and SurfaceHit records, packed into Embree's packets there:
+// pass) or kept in Embree's own packet layout (pass_in_place). The same paths as the scalar loop:
+// a pool of 256, camera rays through the scene's camera, one shadow ray a hit to a point on the
+// first light, a cosine-weighted bounce with a constant albedo, at most five hits. Its random numbers are a
 // counter-based hash in lanes (PCG's output permutation of a per-sample key plus a draw index;
 // M. Jarzynski and M. Olano, "Hash Functions for GPU Rendering", JCGT 9(3), 2020) instead of
 // the scalar loop's PCG32 streams, since a 64-bit multiply has no AVX2 lane form.
@@ -32,15 +32,18 @@ inline vu hash(vu x) {
 inline vf unit(vu h) { return __builtin_convertvector(vi(h >> 8u), vf) * splat(0x1p-24f); }
 inline vu loadu32(const uint32_t* p) { return *reinterpret_cast<const vu*>(p); }
 
-// offset_ray_origin (accel.h) in lanes, as diffuse_lanes_body.inc has it.
-inline vf offset_coordinate(vf p, vf n) {
-  constexpr float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
-  vi of = truncate(splat(int_scale) * n);
-  vi bits = vi(p) + ((p < 0) ? -of : of);
-  return sel(fabs(p) < origin, p + splat(float_scale) * n, vf(bits));
-}
-inline V3 offset_origin(V3 p, V3 n) {
-  return {offset_coordinate(p.x, n.x), offset_coordinate(p.y, n.y), offset_coordinate(p.z, n.z)};
+// A cosine-weighted direction about unit normal n (Frame(n) as Duff et al. 2017 build it, the
+// concentric disk lifted to the hemisphere).
+inline V3 cosine_direction(V3 n, vf u1, vf u2) {
+  const vf one = splat(1.0f);
+  const vf sign = vf((vi(n.z) & int32_t(0x80000000)) | vi(one));
+  const vf a = splat(-1.0f) / (sign + n.z), b = n.x * n.y * a;
+  const V3 s_axis{one + sign * n.x * n.x * a, sign * b, -sign * n.x};
+  const V3 t_axis{b, sign + n.y * n.y * a, -n.y};
+  vf x, y;
+  concentric_disk(u1, u2, x, y);
+  const vf z = sqrt(max0(one - x * x - y * y));
+  return add(add(mul(s_axis, x), mul(t_axis, y)), mul(n, z));
 }
 
 constexpr size_t kPool = 256, kPad = kPool + kW;
@@ -159,15 +162,8 @@ inline MinimalLoopResult pass(const pt::RenderScene& scene, const std::vector<in
         s.tmin = 0;
         s.tmax = stmax[j];
       }
-      // The bounce: Frame(n_face) (Duff et al. 2017), a cosine-weighted direction, spawn_ray.
-      const vf sign = vf((vi(n_face.z) & int32_t(0x80000000)) | vi(one));
-      const vf a = splat(-1.0f) / (sign + n_face.z), b = n_face.x * n_face.y * a;
-      const V3 s_axis{one + sign * n_face.x * n_face.x * a, sign * b, -sign * n_face.x};
-      const V3 t_axis{b, sign + n_face.y * n_face.y * a, -n_face.y};
-      vf x, y;
-      concentric_disk(unit(hash(base + 2u)), unit(hash(base + 3u)), x, y);
-      const vf z = sqrt(max0(one - x * x - y * y));
-      const V3 wi = add(add(mul(s_axis, x), mul(t_axis, y)), mul(n_face, z));
+      // The bounce: a cosine-weighted direction, then spawn_ray.
+      const V3 wi = cosine_direction(n_face, unit(hash(base + 2u)), unit(hash(base + 3u)));
       const V3 side = sel(dot(wi, g) >= 0, g, neg(g));
       store3(v.ox, v.oy, v.oz, int(i), offset_origin(add(p, mul(side, off)), side));
       store3(v.wx, v.wy, v.wz, int(i), wi);
@@ -328,14 +324,7 @@ inline MinimalLoopResult pass_in_place(const pt::RenderScene& scene, const std::
       store3(sp.dx + o, sp.dy + o, sp.dz + o, 0, sd);
       store(sp.tnear + o, vf{});
       store(sp.tfar + o, stmax);
-      const vf sign = vf((vi(n_face.z) & int32_t(0x80000000)) | vi(one));
-      const vf a = splat(-1.0f) / (sign + n_face.z), b = n_face.x * n_face.y * a;
-      const V3 s_axis{one + sign * n_face.x * n_face.x * a, sign * b, -sign * n_face.x};
-      const V3 t_axis{b, sign + n_face.y * n_face.y * a, -n_face.y};
-      vf x, y;
-      concentric_disk(unit(hash(base + 2u)), unit(hash(base + 3u)), x, y);
-      const vf z = sqrt(max0(one - x * x - y * y));
-      const V3 wi = add(add(mul(s_axis, x), mul(t_axis, y)), mul(n_face, z));
+      const V3 wi = cosine_direction(n_face, unit(hash(base + 2u)), unit(hash(base + 3u)));
       const V3 no = offset_origin(p, n_face);
       // Rays of lanes without a hit keep their (finite) old values: their slot restarts.
       store3(pk.ox + o, pk.oy + o, pk.oz + o, 0, sel(hit, no, load3(pk.ox, pk.oy, pk.oz, int(o))));

@@ -79,9 +79,11 @@ class Accel {
   // Benchmarks only (bench/minimal_loop_lanes.h; the renderer never calls them): 16 rays kept in
   // Embree's own packet layout (RTCRayHit16's fields in order), traced where they lie, with no
   // packing and no hit refinement: what an integrator whose rays live in lanes would call. Lanes
-  // whose valid[k] is 0 are left as they are. intersect16 leaves t in tfar, geom[k] != ~0u where a
-  // lane hit and Embree's unnormalised geometric normal in ng*; occluded16 (which reads only the
-  // ray fields) sets tfar < 0 where a lane is blocked. Recorded and timed like every query.
+  // whose valid[k] (16 ints, -1 or 0, 64-byte aligned as Embree reads them) is 0 are left as they
+  // are. Before intersect16 the caller sets tnear, tfar and geom[k] = inst[k] = ~0u; it leaves t in
+  // tfar, geom[k] != ~0u where a lane hit and Embree's unnormalised geometric normal in ng*.
+  // occluded16 reads only the ray fields and sets tfar < 0 where a lane is blocked. Both are
+  // recorded and timed like every query.
   struct RayPacket16 {
     alignas(64) float ox[16], oy[16], oz[16], tnear[16], dx[16], dy[16], dz[16], time[16], tfar[16];
     uint32_t mask[16], id[16], flags[16];
