@@ -163,7 +163,8 @@ TEST(BenchSmoke, Ceiling) {
   // The split of the one-thread pass: three shares that add up to the whole, Embree's share of
   // the raw replay, the Embree calls' time in the pass over the replay's, the rest a ray.
   std::smatch m;
-  std::regex split(R"(\ndof +(\d+\.\d)% +(\d+\.\d)% +(-?\d+\.\d)% +(\d+\.\d)% +(\d+\.\d\d) +(\d+\.\d)\n)");
+  std::regex split(
+      R"(\ndof +(\d+\.\d)% +(\d+\.\d)% +(-?\d+\.\d)% +(\d+\.\d)% +(\d+\.\d\d) +(\d+\.\d) +(\d+\.\d\d) +(-?\d+\.\d\d)\n)");
   ASSERT_TRUE(std::regex_search(out, m, split)) << out;
   const double embree = std::stod(m[1]), refine = std::stod(m[2]), rest = std::stod(m[3]);
   EXPECT_GT(embree, 0) << m.str();
@@ -175,6 +176,11 @@ TEST(BenchSmoke, Ceiling) {
   EXPECT_GT(std::stod(m[5]), 0) << m.str();
   EXPECT_GT(std::stod(m[6]), 0) << m.str();
   const double pt_rest = std::stod(m[6]);
+  // The budget columns follow from the shares: own/Embree = (refine + rest) / Embree, and the
+  // allowance 1 / (0.70 x raw share x Embree PT/raw) - 1 (within the printed rounding).
+  EXPECT_NEAR(std::stod(m[7]), (refine + rest) / embree, 0.01 + 0.002 * (refine + rest) / embree) << m.str();
+  const double allowed = 1.0 / (0.70 * std::stod(m[4]) / 100.0 * std::stod(m[5])) - 1.0;
+  EXPECT_NEAR(std::stod(m[8]), allowed, 0.01 + 0.01 * std::fabs(allowed)) << m.str();
   // The target's verdict agrees with the table: its lowest is the smallest PT/raw (each row's
   // second ratio) and it is met exactly when that reaches 0.70.
   const auto rows = row_ratios(out, "dof");
