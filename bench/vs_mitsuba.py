@@ -4,7 +4,7 @@
 on this machine, in one run.
 
     python3 bench/vs_mitsuba.py [--scenes CBspheres,CBbunny] [--spp 64] [--runs 3] [--ref-spp 1024]
-                                [--ours=--no-caustic-tracing]
+                                [--ours=--no-caustic-tracing] [--profile]
 
 Mitsuba comes from PyPI into build/mitsuba-venv (mitsuba 3.5.2: later Dr.Jit versions emit LLVM IR
 that needs LLVM 16 or newer, and Debian 12 ships 14 and 15; Dr.Jit finds Debian's libLLVM through
@@ -17,7 +17,8 @@ and the two references are compared with each other to check that the conversion
 Timings exclude start-up: Mitsuba's kernel compilation (one warm-up render) and our scene load.
 --ours adds flags to our timed runs only (the reference keeps the defaults): flags that change how
 we sample, not what converges, such as --no-caustic-tracing (unidirectional path tracing, as
-Mitsuba's `path` does) or --no-ray-packets.
+Mitsuba's `path` does) or --no-ray-packets. --profile also prints each renderer's share of time in
+ray queries, measured with perf (query_share.py), which sets its rays/s over the raw ceiling.
 """
 import argparse
 import json
@@ -29,6 +30,7 @@ import sys
 import time
 from pathlib import Path
 
+import query_share
 from progress import clear, progress
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -144,11 +146,16 @@ def host_description():
     return f"{model}, {len(os.sched_getaffinity(0))} CPUs, {isa}"
 
 
-def run_ours(args, scene_path, depth, spp, out, seed, extra=()):
+def ours_command(args, scene_path, depth, spp, out, seed, extra=()):
     cmd = [str(BUILD / "pathtracer"), "-t", "2", "-s", str(spp), "-l", "1", "-m", str(depth), "-r", "480", "360",
            "--keep-fov", "--no-adaptive", "--quiet", "--seed", str(seed), *extra, "-f", str(out), str(scene_path)]
     if args.sampler:
         cmd[1:1] = ["--sampler", args.sampler]
+    return cmd
+
+
+def run_ours(args, scene_path, depth, spp, out, seed, extra=()):
+    cmd = ours_command(args, scene_path, depth, spp, out, seed, extra)
     text = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
     m = re.search(r"([\d.]+) s, ([\d.e+]+) samples/s", text)
     return float(m.group(1)), float(m.group(2))
@@ -163,10 +170,15 @@ def main():
     ap.add_argument("--depth", type=int, default=0, help="our -m for every scene (default: 5)")
     ap.add_argument("--sampler", default="", help="our sampler (sobol, independent; default ours)")
     ap.add_argument("--ours", default="", help="extra pathtracer flags for our timed runs, e.g. --ours=--no-caustic-tracing")
+    ap.add_argument("--profile", action="store_true",
+                    help="also measure each renderer's share of time in ray queries with perf (query_share.py)")
     args = ap.parse_args()
     if not SHARED.exists():
         print("vs_mitsuba: skipping: ../shared/scenes-cs184 is absent")
         return
+    why_not = args.profile and query_share.available()
+    if why_not:
+        sys.exit(f"vs_mitsuba: --profile: {why_not}")
     llvm = find_libllvm()
     if not llvm:
         sys.exit("vs_mitsuba: no libLLVM 14/15 found (Debian: libllvm15); Mitsuba's llvm variant needs it")
@@ -226,6 +238,18 @@ def main():
             ot.append(sec)
             orate.append(rate)
             oe.append(rel_mse(np, np.array(mi.Bitmap(str(out))), oref))
+        shares = None
+        if args.profile:
+            # After the timed runs, so that perf's own cost never enters a timing. Ours renders 4x the
+            # samples so that its start-up (scene load, image writing) weighs little in its share.
+            progress(f"{name}: profiles", 0, started)
+            m_share = query_share.profile_self(
+                cache / f"perf-mitsuba-{name}.data",
+                lambda: [np.array(mi.render(scene, seed=200 + k)) for k in range(args.runs)])
+            o_share = query_share.profile_command(
+                cache / f"perf-ours-{name}.data",
+                ours_command(args, SHARED / file, depth, 4 * args.spp, out, 200, args.ours.split()))
+            shares = (m_share[0], o_share[0])
         clear()
         lum = np.array([0.2126, 0.7152, 0.0722])
         mean_m, mean_o = float(np.mean(mref[..., :3] @ lum)), float(np.mean(oref[..., :3] @ lum))
@@ -233,10 +257,10 @@ def main():
         m_sec, o_sec = statistics.median(mt), statistics.median(ot)
         m_err, o_err = statistics.median(me), statistics.median(oe)
         rows.append((name, depth, m_sec, pixels * args.spp / m_sec, m_err, o_sec, statistics.median(orate), o_err,
-                     mean_m, mean_o, cross))
+                     mean_m, mean_o, cross, shares))
     print(header)
     samples, efficiency = [], []  # ours over Mitsuba's, per scene
-    for name, depth, m_sec, m_rate, m_err, o_sec, o_rate, o_err, mean_m, mean_o, cross in rows:
+    for name, depth, m_sec, m_rate, m_err, o_sec, o_rate, o_err, mean_m, mean_o, cross, shares in rows:
         samples.append((name, o_rate / m_rate))
         efficiency.append((name, (m_err * m_sec) / (o_err * o_sec)))
         print(f"{name:<10} {'mitsuba':<9} {m_sec:8.3f} {m_rate / 1e6:12.2f} {m_err:10.5f} {1 / (m_err * m_sec):11.1f}")
@@ -245,6 +269,9 @@ def main():
         print(f"{'':<10} ours/mitsuba: samples/s {samples[-1][1]:.2f}x, efficiency "
               f"{efficiency[-1][1]:.2f}x; references: mean luminance {mean_o:.4f} vs {mean_m:.4f} "
               f"({100 * (mean_o / mean_m - 1):+.1f}%), relMSE between them {cross:.5f}")
+        if shares:
+            print(f"{'':<10} share of time in ray queries (perf): Mitsuba "
+                  f"{100 * shares[0]:.1f}%, ours {100 * shares[1]:.1f}%")
     print(verdict("samples/s >= Mitsuba's on every scene", 1.0, samples))
     print(verdict("efficiency 1/(relMSE x s) >= 2x Mitsuba's on every scene", 2.0, efficiency))
 
