@@ -249,7 +249,7 @@ def main():
             o_share = query_share.profile_command(
                 cache / f"perf-ours-{name}.data",
                 ours_command(args, SHARED / file, depth, 4 * args.spp, out, 200, args.ours.split()))
-            shares = (m_share[0], o_share[0])
+            shares = (m_share, o_share)
         clear()
         lum = np.array([0.2126, 0.7152, 0.0722])
         mean_m, mean_o = float(np.mean(mref[..., :3] @ lum)), float(np.mean(oref[..., :3] @ lum))
@@ -270,8 +270,9 @@ def main():
               f"{efficiency[-1][1]:.2f}x; references: mean luminance {mean_o:.4f} vs {mean_m:.4f} "
               f"({100 * (mean_o / mean_m - 1):+.1f}%), relMSE between them {cross:.5f}")
         if shares:
-            print(f"{'':<10} share of time in ray queries (perf): Mitsuba "
-                  f"{100 * shares[0]:.1f}%, ours {100 * shares[1]:.1f}%")
+            (m_q, m_n), (o_q, o_n) = shares
+            print(f"{'':<10} share of time in ray queries (perf): Mitsuba {100 * m_q:.1f}% of {m_n} samples, "
+                  f"ours {100 * o_q:.1f}% of {o_n}")
     print(verdict("samples/s >= Mitsuba's on every scene", 1.0, samples))
     print(verdict("efficiency 1/(relMSE x s) >= 2x Mitsuba's on every scene", 2.0, efficiency))
 
