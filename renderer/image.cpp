@@ -145,4 +145,8 @@ std::string encode_exr(const ImageRGB& img, const Metadata& meta) { return modul
 
 ImageRGB read_image(const std::string& path) { return module().read_image(path); }
 
+std::string check_image_file(const std::string& path, int width, int height) {
+  return module().check_image_file(path, width, height);
+}
+
 }  // namespace pt

@@ -51,6 +51,10 @@ std::string encode_png8(const std::vector<uint8_t>& rgb, int width, int height);
 std::string encode_exr(const ImageRGB& img, const Metadata& meta = {});
 // Reads any image OpenImageIO can read as linear RGB float (top row first); throws on failure.
 ImageRGB read_image(const std::string& path);
+// Empty when the image file reads back whole as a width x height image (a PNG also ends with its
+// IEND chunk), else what is wrong with it. Files written by write_image are checked so before
+// they take their name; this checks files written earlier.
+std::string check_image_file(const std::string& path, int width, int height);
 // Throws, naming where it looked, when the image module is not there, without loading it: called
 // before renders whose images would otherwise be lost to a missing module at the end.
 void require_image_io();

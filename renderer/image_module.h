@@ -14,7 +14,7 @@
 namespace pt {
 
 // Bumped whenever the table below changes, so a stale module is refused by name, not called.
-constexpr uint32_t kImageModuleAbi = 2;
+constexpr uint32_t kImageModuleAbi = 3;
 
 struct ImageModule {
   uint32_t abi;
@@ -28,6 +28,8 @@ struct ImageModule {
   ImageRGB (*read_image)(const std::string& path);
   // Empty when there is a writer for the path's format, else why not (nothing is written).
   std::string (*writer_problem)(const std::string& path);
+  // Empty when the file reads back whole as a width x height image, else what is wrong.
+  std::string (*check_image_file)(const std::string& path, int width, int height);
 };
 
 }  // namespace pt

@@ -7,10 +7,12 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <vector>
 
 #include "image_module.h"
 
@@ -30,6 +32,57 @@ std::string temp_name(const std::string& path) {
   return dir + "." + base + ".tmp" + std::to_string(getpid()) + "-" + std::to_string(counter++);
 }
 
+// A PNG's last 12 bytes are its IEND chunk (length 0, type, CRC): a file cut short lacks them.
+bool ends_with_iend(const std::string& path) {
+  static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  unsigned char tail[12];
+  off_t size = ::lseek(fd, 0, SEEK_END);
+  bool ok = size >= 12 && ::pread(fd, tail, 12, size - 12) == 12 && std::memcmp(tail, iend, 12) == 0;
+  ::close(fd);
+  return ok;
+}
+
+std::string extension(const std::string& path) {
+  std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+  for (char& c : ext) c = char(std::tolower((unsigned char)c));
+  return ext;
+}
+bool is_png(const std::string& path) { return extension(path) == ".png"; }
+
+// Reads the file at `path` whole as `type` ("" when it holds width x height x channels pixels),
+// into `pixels` when given.
+std::string read_back(const std::string& path, bool png, int width, int height, int channels, OIIO::TypeDesc type,
+                      std::vector<unsigned char>* pixels) {
+  if (png && !ends_with_iend(path)) return "the file is cut short (no IEND chunk)";
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return "cannot be read back (" + OIIO::geterror() + ")";
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width != width || spec.height != height || spec.nchannels < channels)
+    return "reads back as " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " with " +
+           std::to_string(spec.nchannels) + " channels, not " + std::to_string(width) + "x" + std::to_string(height);
+  std::vector<unsigned char> buf(size_t(width) * height * channels * type.size());
+  if (!in->read_image(0, 0, 0, channels, type, buf.data())) return "its pixels cannot be read back (" + in->geterror() + ")";
+  if (pixels) *pixels = std::move(buf);
+  return "";
+}
+
+// Reads a written temp file back and compares it with what was meant: a writer that reported
+// success on a full disk (seen with PNG) must not put a truncated image in place.
+void verify_written(const std::string& path, const std::string& tmp, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
+                    const void* data) {
+  std::vector<unsigned char> back;
+  std::string why = read_back(tmp, is_png(path), spec.width, spec.height, spec.nchannels, type, &back);
+  bool lossless = is_png(path) || extension(path) == ".exr";  // a JPEG reads back other pixels by design
+  if (why.empty() && lossless && std::memcmp(back.data(), data, back.size()) != 0) why = "its pixels differ from those written";
+  if (!why.empty()) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot write image: the written file " + why +
+                             " (a short write: is the disk full?)");
+  }
+}
+
 void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type, const void* data) {
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw std::runtime_error(path + ": cannot write this image format (" + OIIO::geterror() + ")");
@@ -41,7 +94,7 @@ void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, OIIO::Ty
     int why = errno;
     std::string err = out->geterror();
     if (why == ENOSPC || why == EFBIG || why == EDQUOT || why == EROFS || why == EIO || why == ENOENT || why == ENOTDIR ||
-        why == EACCES)
+        why == EACCES || why == EMFILE || why == ENFILE)
       err += std::string(err.empty() ? "" : " ") + "(" + std::strerror(why) + ")";
     std::remove(tmp.c_str());
     throw std::runtime_error(path + ": cannot write image: " + err);
@@ -55,6 +108,7 @@ void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, OIIO::Ty
     throw std::runtime_error(path + ": cannot write image: " + err);
   }
   ::close(fd);
+  verify_written(path, tmp, spec, type, data);
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
     throw std::runtime_error(path + ": cannot move the finished image into place");
@@ -131,6 +185,10 @@ ImageRGB read_image(const std::string& path) {
   return img;
 }
 
+std::string check_image_file(const std::string& path, int width, int height) {
+  return read_back(path, is_png(path), width, height, 3, OIIO::TypeDesc::FLOAT, nullptr);
+}
+
 std::string writer_problem(const std::string& path) {
   if (OIIO::ImageOutput::create(path)) return "";
   return "cannot write this image format (" + OIIO::geterror() + ")";
@@ -141,6 +199,7 @@ std::string writer_problem(const std::string& path) {
 extern "C" __attribute__((visibility("default"))) const pt::ImageModule* pt_image_module() {
   namespace m = pt::oiio_module;
   static const pt::ImageModule table = {pt::kImageModuleAbi, m::write_exr,  m::write_rgb8,    m::encode_png8,
-                                        m::encode_exr,       m::read_image, m::writer_problem};
+                                        m::encode_exr,       m::read_image, m::writer_problem,
+                                        m::check_image_file};
   return &table;
 }

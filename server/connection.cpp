@@ -212,6 +212,14 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
     t_close = false;
     bool closed_by_client = false;
     ret = process_request(strm, left == 1, closed_by_client, nullptr);
+    if (strm.failure() == ReadFailure::head_too_large && strm.status() == 0) {
+      // A request line over the cap fails inside httplib's line reader, which then answers nothing.
+      std::string body = "{\"error\":{\"status\":431,\"message\":\"the request line and headers exceed " +
+                         std::to_string(m_limits.max_head_bytes) + " bytes\"}}";
+      std::string all = "HTTP/1.1 431 Request Header Fields Too Large\r\nContent-Type: application/json\r\n"
+                        "Connection: close\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body;
+      strm.write(all.data(), all.size());
+    }
     linger = t_close || strm.failure() != ReadFailure::none || ends_connection(strm.status());
     if (!ret || closed_by_client || linger) break;
   }

@@ -12,6 +12,12 @@ namespace srv {
 
 using json = nlohmann::json;
 
+// Serialises JSON that may hold text from outside (scene files, error messages, Redis): invalid
+// UTF-8 becomes U+FFFD instead of an exception. Every dump in the server goes through it.
+inline std::string dump_json(const json& j, int indent = -1) {
+  return j.dump(indent, ' ', false, json::error_handler_t::replace);
+}
+
 // A request error: HTTP status, message and the offending field ("" when none).
 class ApiError : public std::runtime_error {
  public:

@@ -20,15 +20,18 @@
 
 #include "collada.h"
 #include "image.h"
+#include "job_sink.h"
+#include "job_store.h"
 #include "render_backend.h"
+#include "request_policy.h"
 
 namespace srv {
 
-namespace {
-
-double now_unix() {
+double now_unix_seconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
+
+namespace {
 
 std::string new_job_id() {
   // Sortable by creation time, unique within a process and across restarts.
@@ -41,6 +44,19 @@ std::string new_job_id() {
   return buf;
 }
 
+// Why a done job's stored images cannot be served ("" when both read back whole at the job's size).
+std::string stored_image_problem(const std::string& dir, const JobSpec& spec) {
+  int w = spec.params.cell_w > 0 ? spec.params.cell_w : spec.params.width;
+  int h = spec.params.cell_w > 0 ? spec.params.cell_h : spec.params.height;
+  for (const char* name : {"image.png", "image.exr"}) {
+    std::string path = dir + "/" + name;
+    if (!is_regular_file(path)) return std::string(name) + " is missing, empty or not a regular file";
+    std::string why = pt::check_image_file(path, w, h);
+    if (!why.empty()) return std::string(name) + ": " + why;
+  }
+  return "";
+}
+
 bool valid_job_id(const std::string& id) {
   if (id.empty() || id.size() > 40) return false;
   for (char c : id)
@@ -48,69 +64,7 @@ bool valid_job_id(const std::string& id) {
   return true;
 }
 
-void make_dirs(const std::string& path) {
-  std::string cur;
-  std::stringstream ss(path);
-  std::string part;
-  if (!path.empty() && path[0] == '/') cur = "/";
-  while (std::getline(ss, part, '/')) {
-    if (part.empty()) continue;
-    cur += part + "/";
-    mkdir(cur.c_str(), 0755);
-  }
-}
-
-// Writes a whole file under a temp name, flushes it to the disk and renames it into place: readers,
-// and a server restarted after a crash, never see a partial file. Errors name the file and the cause
-// (no space, not a directory, ...).
-void write_file_atomic(const std::string& path, const std::string& data) {
-  std::string tmp = path + ".tmp" + std::to_string(getpid());
-  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
-  size_t done = 0;
-  int err = 0;
-  while (done < data.size() && !err) {
-    ssize_t n = ::write(fd, data.data() + done, data.size() - done);
-    if (n < 0 && errno != EINTR) err = errno;
-    if (n > 0) done += size_t(n);
-  }
-  if (!err && ::fsync(fd) != 0) err = errno;
-  if (::close(fd) != 0 && !err) err = errno;
-  if (err) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write " + path + ": " + std::strerror(err));
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    err = errno;
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot move " + path + " into place: " + std::strerror(err));
-  }
-}
-
-// Temp files a killed server left behind (job.json.tmp<pid>, .image.exr.tmp<pid>-<n>): never read,
-// removed at start so they cannot pile up. Returns how many.
-int remove_temp_files(const std::string& dir) {
-  int removed = 0;
-  if (DIR* d = opendir(dir.c_str())) {
-    while (dirent* e = readdir(d)) {
-      std::string name = e->d_name;
-      if (name.find(".tmp") != std::string::npos && std::remove((dir + "/" + name).c_str()) == 0) ++removed;
-    }
-    closedir(d);
-  }
-  return removed;
-}
-
 }  // namespace
-
-bool read_file(const std::string& path, std::string& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  out = ss.str();
-  return true;
-}
 
 const char* job_state_name(JobState s) {
   switch (s) {
@@ -142,7 +96,12 @@ int JobManager::live_workers() const { return m_backend ? m_backend->live_worker
 std::string JobManager::job_dir(const std::string& id) const { return m_config.data_dir + "/jobs/" + id; }
 
 void JobManager::start() {
-  make_dirs(m_config.data_dir + "/jobs");
+  try {
+    make_dirs(m_config.data_dir + "/jobs");
+  } catch (const std::exception& e) {
+    throw std::runtime_error("data directory '" + m_config.data_dir + "' is not writable (" + e.what() + ")");
+  }
+  m_lock = std::make_unique<DataDirLock>(m_config.data_dir);
   // A real write, not access(): root passes access() on a read-only mount or a full disk.
   try {
     std::string probe = m_config.data_dir + "/jobs/.write-probe";
@@ -200,12 +159,12 @@ std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const
   job->id = new_job_id();
   job->spec = spec;
   job->idempotency_key = key;
-  job->created_at = now_unix();
+  job->created_at = now_unix_seconds();
   {
     // Stored before it is acknowledged: a job the client was told about survives a crash.
     std::lock_guard<std::mutex> jl(job->mutex);
-    make_dirs(job_dir(job->id));
     try {
+      make_dirs(job_dir(job->id));
       write_job_file(*job);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "render-server: job %s: %s\n", job->id.c_str(), e.what());
@@ -245,7 +204,7 @@ void JobManager::cancel(const std::string& id) {
       m_queue.erase(it);
       std::lock_guard<std::mutex> jl(job->mutex);
       job->state = JobState::cancelled;
-      job->finished_at = now_unix();
+      job->finished_at = now_unix_seconds();
       ++job->version;
       persist(*job);
       job->changed.notify_all();
@@ -277,6 +236,7 @@ json JobManager::status_json(const Job& j, bool with_history) const {
          {"width", j.spec.params.cell_w > 0 ? j.spec.params.cell_w : j.spec.params.width},
          {"height", j.spec.params.cell_h > 0 ? j.spec.params.cell_h : j.spec.params.height},
          {"tile_size", j.spec.params.tile_size},
+         {"stream_tile_size", stream_tile_size(j.spec.params.tile_size)},
          {"features", j.features},
          {"images", {{"png", "/api/jobs/" + j.id + "/image.png"}, {"exr", "/api/jobs/" + j.id + "/image.exr"}}},
          {"events", "/api/jobs/" + j.id + "/events"}};
@@ -294,7 +254,14 @@ double JobManager::focus_distance(const Job& job, double x, double y) {
   std::string size = std::to_string(p.width) + "x" + std::to_string(p.height);
   if (!(x >= 0 && x <= p.width)) throw ApiError(400, "x must lie inside the " + size + " image", "x");
   if (!(y >= 0 && y <= p.height)) throw ApiError(400, "y must lie inside the " + size + " image", "y");
-  auto base = m_scenes.load(job.spec.scene);
+  std::shared_ptr<const pt::SceneBase> base;
+  try {
+    base = m_scenes.load(job.spec.scene);
+  } catch (const ApiError& e) {  // the scene file is gone: the job is fine, its scene is not
+    throw ApiError(422, "the job's scene no longer loads: " + std::string(e.what()), "scene");
+  } catch (const pt::SceneError& e) {
+    throw ApiError(422, "the job's scene no longer loads: " + to_valid_utf8(e.what()), "scene");
+  }
   p.env_map.clear();
   auto scene = pt::make_view(*base, p);
   return pt::autofocus_distance(*scene, float(x / p.width), float(1 - y / p.height));
@@ -303,7 +270,7 @@ double JobManager::focus_distance(const Job& job, double x, double y) {
 void JobManager::write_job_file(Job& j) {
   json doc = status_json(j);
   doc["idempotency_key"] = j.idempotency_key;
-  write_file_atomic(job_dir(j.id) + "/job.json", doc.dump(1));
+  write_file_atomic(job_dir(j.id) + "/job.json", dump_json(doc, 1));
 }
 
 void JobManager::persist(Job& j) {
@@ -319,16 +286,25 @@ void JobManager::load_persisted() {
   DIR* d = opendir(root.c_str());
   if (!d) return;
   std::vector<std::string> ids;
-  while (dirent* e = readdir(d))
-    if (valid_job_id(e->d_name)) ids.push_back(e->d_name);
+  while (dirent* e = readdir(d)) {
+    struct stat st;
+    if (!valid_job_id(e->d_name)) continue;
+    if (::lstat((root + "/" + e->d_name).c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+      std::fprintf(stderr, "render-server: skipping %s/%s: not a folder\n", root.c_str(), e->d_name);
+    else
+      ids.push_back(e->d_name);
+  }
   closedir(d);
   std::sort(ids.begin(), ids.end());  // ids sort by creation time: the queue keeps its order
   int temp_files = 0;
   for (const std::string& id : ids) {
     temp_files += remove_temp_files(root + "/" + id);
-    std::string text;
-    if (!read_file(root + "/" + id + "/job.json", text)) {
-      rmdir((root + "/" + id).c_str());  // empty: killed between mkdir and job.json (never acknowledged)
+    std::string text, why;
+    if (!read_file(root + "/" + id + "/job.json", text, &why)) {
+      // Empty: killed between mkdir and job.json (never acknowledged). Anything else (a FIFO, a
+      // link) is not ours to read: skipped, said once.
+      if (::rmdir((root + "/" + id).c_str()) != 0)
+        std::fprintf(stderr, "render-server: skipping %s/%s/job.json: %s\n", root.c_str(), id.c_str(), why.c_str());
       continue;
     }
     try {
@@ -340,15 +316,19 @@ void JobManager::load_persisted() {
       job->created_at = doc.value("created_at", 0.0);
       JobState st = JobState::queued;
       parse_job_state(doc.value("state", "queued"), &st);
-      struct stat sb;
-      auto present = [&](const char* name) {
-        return stat((root + "/" + id + "/" + name).c_str(), &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0;
-      };
-      bool image_ok = present("image.png") && present("image.exr");
-      if (st == JobState::running || (st == JobState::done && !image_ok)) st = JobState::queued;  // interrupted: run again
+      if (st == JobState::done) {
+        // A done job counts only with images that read back whole at its size (a disk that filled
+        // up may have left a truncated file behind a successful write): otherwise it renders again.
+        std::string problem = stored_image_problem(root + "/" + id, job->spec);
+        if (!problem.empty()) {
+          std::fprintf(stderr, "render-server: job %s: %s; rendering it again\n", id.c_str(), problem.c_str());
+          st = JobState::queued;
+        }
+      }
+      if (st == JobState::running) st = JobState::queued;  // interrupted: run again
       job->state = st;
       if (st != JobState::queued) {
-        job->message = doc.value("message", "");
+        job->message = to_valid_utf8(doc.value("message", ""));
         job->progress = doc.value("progress", 0.0);
         job->samples = doc.value("samples", uint64_t(0));
         job->elapsed = doc.value("elapsed", 0.0);
@@ -359,7 +339,9 @@ void JobManager::load_persisted() {
         if (doc.contains("finished_at") && doc["finished_at"].is_number()) job->finished_at = doc["finished_at"];
         for (const json& p : doc.value("error_history", json::array()))
           job->history.push_back({p.value("seconds", 0.0), p.value("spp", 0.0), p.value("error", 0.0)});
-        if (doc.contains("features")) job->features = doc["features"].get<std::vector<std::string>>();
+        if (doc.contains("features"))
+          for (const json& f : doc["features"])
+            if (f.is_string()) job->features.push_back(to_valid_utf8(f.get<std::string>()));
         job->width = job->spec.params.width;
         job->height = job->spec.params.height;
       }
@@ -390,105 +372,6 @@ void JobManager::worker_loop() {
     run_job(job);
   }
 }
-
-namespace {
-
-// Carries a backend's reports into the job's state (under its mutex) and wakes its watchers.
-class JobStateSink : public JobSink {
- public:
-  JobStateSink(Job& job, std::function<void(Job&)> persist) : m_job(job), m_persist(std::move(persist)) {}
-
-  void started(int width, int height, const std::vector<std::string>& features) override {
-    Job& j = m_job;
-    {
-      std::lock_guard<std::mutex> lock(j.mutex);
-      if (j.cancel) throw ApiError(409, "cancelled");
-      j.state = JobState::running;
-      j.started_at = now_unix();
-      j.width = width;
-      j.height = height;
-      j.tile_size = j.spec.params.tile_size;
-      j.tiles_x = (width + j.tile_size - 1) / j.tile_size;
-      j.tiles_y = (height + j.tile_size - 1) / j.tile_size;
-      size_t n = size_t(width) * height;
-      j.linear.assign(n * 3, 0.0f);
-      j.display.assign(n * 3, 0);
-      j.tile_version.assign(size_t(j.tiles_x) * j.tiles_y, 0);
-      j.tile_png.assign(j.tile_version.size(), std::string());
-      j.tile_png_version.assign(j.tile_version.size(), 0);
-      j.samples = 0;
-      j.history.clear();
-      j.has_image = false;
-      j.features = features;
-      ++j.version;
-      m_persist(j);
-    }
-    m_start = std::chrono::steady_clock::now();
-    m_last_persist = m_start;
-    j.changed.notify_all();
-  }
-
-  void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean) override {
-    Job& j = m_job;
-    {
-      std::lock_guard<std::mutex> lock(j.mutex);
-      size_t k = 0;
-      for (int y = t.y0; y < t.y1; ++y)
-        for (int x = t.x0; x < t.x1; ++x, ++k) {
-          size_t i = (size_t(y) * j.width + x) * 3;
-          for (int c = 0; c < 3; ++c) {
-            j.linear[i + c] = mean[k][c];
-            j.display[i + c] = pt::tonemap_course(mean[k][c]);
-          }
-        }
-      j.tile_version[size_t(t.y0 / j.tile_size) * j.tiles_x + t.x0 / j.tile_size] = ++j.version;
-      j.has_image = true;
-      j.elapsed = seconds();
-    }
-    // Every notify wakes every watcher, and each takes the job's mutex the render threads need:
-    // tile updates wake them at most every kTileNotifyGap (watchers batch tiles over 40 ms rounds
-    // anyway); pass() and state changes, which always follow the tiles, wake them at once.
-    int64_t now = std::chrono::steady_clock::now().time_since_epoch().count(), last = m_last_notify.load();
-    if (now - last >= kTileNotifyGap && m_last_notify.compare_exchange_strong(last, now)) j.changed.notify_all();
-  }
-
-  void pass(const RenderReport& r) override {
-    Job& j = m_job;
-    {
-      std::lock_guard<std::mutex> lock(j.mutex);
-      j.samples = r.samples;
-      j.rays = r.rays;
-      j.nonfinite = r.nonfinite;
-      j.elapsed = seconds();
-      j.progress = r.progress;
-      if (std::isfinite(r.error)) {
-        j.error_estimate = r.error;
-        j.history.push_back({j.elapsed, double(r.samples) / (double(j.width) * j.height), r.error});
-      }
-      pt::RunLimits limits;
-      limits.target_error = j.spec.target_error;
-      limits.time_limit = j.spec.time_limit;
-      j.eta = pt::remaining_seconds(j.elapsed, j.progress, r.error, j.elapsed, limits);
-      ++j.version;
-      if (std::chrono::steady_clock::now() - m_last_persist > std::chrono::seconds(1)) {
-        m_persist(j);
-        m_last_persist = std::chrono::steady_clock::now();
-      }
-    }
-    j.changed.notify_all();
-  }
-
- private:
-  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count(); }
-  Job& m_job;
-  std::function<void(Job&)> m_persist;
-  std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last_persist = m_start;
-  static constexpr int64_t kTileNotifyGap =
-      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::milliseconds(20)).count();
-  std::atomic<int64_t> m_last_notify{0};
-};
-
-}  // namespace
 
 void JobManager::run_job(const std::shared_ptr<Job>& job) {
   auto notify = [&] { job->changed.notify_all(); };
@@ -529,7 +412,7 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
     if (job->cancel) {
       std::lock_guard<std::mutex> lock(job->mutex);
       job->state = JobState::cancelled;
-      job->finished_at = now_unix();
+      job->finished_at = now_unix_seconds();
       ++job->version;
       persist(*job);
       notify();
@@ -540,7 +423,7 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
     const RenderReport& r = result.report;
     pt::Metadata meta{{"pathtracer:scene", job->spec.scene},
                       {"pathtracer:job", job->id},
-                      {"pathtracer:spec", job_spec_to_json(job->spec).dump()},
+                      {"pathtracer:spec", dump_json(job_spec_to_json(job->spec))},
                       {"pathtracer:achieved_spp", std::to_string(double(r.samples) / (double(img.width) * img.height))},
                       {"pathtracer:wall_seconds", std::to_string(result.seconds)},
                       {"pathtracer:error_estimate", std::to_string(r.error)},
@@ -548,8 +431,10 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
                       {"pathtracer:nonfinite_samples", std::to_string(r.nonfinite)},
                       {"pathtracer:backend", m_backend->name()}};
     try {
-      pt::write_image(img, job_dir(job->id) + "/image.exr", meta);
-      pt::write_image(img, job_dir(job->id) + "/image.png");
+      // Each file is read back and compared before its rename (pt::write_image); a write that fails
+      // for want of a descriptor (a connection flood) is retried rather than losing the render.
+      retry_without_descriptors([&] { pt::write_image(img, job_dir(job->id) + "/image.exr", meta); });
+      retry_without_descriptors([&] { pt::write_image(img, job_dir(job->id) + "/image.png"); });
     } catch (const std::exception& e) {  // a full disk or a vanished data directory: the job fails, saying so
       std::string why = e.what(), dir = job_dir(job->id) + "/";
       for (size_t at; (at = why.find(dir)) != std::string::npos;) why.erase(at, dir.size());  // no server paths
@@ -562,7 +447,7 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
     job->samples = r.samples;
     job->rays = r.rays;
     job->nonfinite = r.nonfinite;
-    job->finished_at = now_unix();
+    job->finished_at = now_unix_seconds();
     ++job->version;
     persist(*job);
     notify();
@@ -573,8 +458,8 @@ void JobManager::run_job(const std::shared_ptr<Job>& job) {
       job->message = dynamic_cast<const std::bad_alloc*>(&e)
                          ? "out of memory for a " + std::to_string(job->spec.params.width) + "x" +
                                std::to_string(job->spec.params.height) + " image; a smaller size needs less"
-                         : e.what();
-    job->finished_at = now_unix();
+                         : to_valid_utf8(e.what());
+    job->finished_at = now_unix_seconds();
     ++job->version;
     persist(*job);
     notify();

@@ -13,19 +13,21 @@
 #include <vector>
 
 #include "job_spec.h"
+#include "job_store.h"
 #include "scene_library.h"
 
 namespace srv {
 
 class RenderBackend;
 
-// Reads a whole file (job images, job.json); false when it cannot be opened.
-bool read_file(const std::string& path, std::string& out);
-
 enum class JobState { queued, running, done, failed, cancelled };
 const char* job_state_name(JobState s);
 bool parse_job_state(const std::string& s, JobState* out);
 inline bool is_final(JobState s) { return s == JobState::done || s == JobState::failed || s == JobState::cancelled; }
+
+constexpr int kMinRegion = 64;  // the smallest square an event stream sends as one tile event
+// The side of the squares a job's event stream sends: whole render tiles, at least kMinRegion.
+inline int stream_tile_size(int tile_size) { return tile_size * ((kMinRegion + tile_size - 1) / tile_size); }
 
 struct ErrorPoint {
   double seconds, spp, error;
@@ -49,15 +51,26 @@ struct Job {
   std::vector<ErrorPoint> history;
   std::vector<std::string> features;
 
-  // The live image: linear RGB, the 8-bit display version, and per-tile versions.
-  int width = 0, height = 0, tile_size = 32, tiles_x = 0, tiles_y = 0;
+  // The live image: linear RGB and its 8-bit display version. Clients are sent it in regions of at
+  // least kMinRegion pixels a side whatever the render's tile size (tiles nest in regions), so
+  // that what watching costs does not depend on a client's choice of tile size.
+  int width = 0, height = 0, tile_size = 32, region_size = 64, regions_x = 0, regions_y = 0;
   std::vector<float> linear;
   std::vector<uint8_t> display;
-  std::vector<uint64_t> tile_version;
+  std::vector<uint64_t> region_version;  // the job version that last changed each region
+  uint64_t passes = 0;                   // passes published so far (the whole-image PNG's cache key)
   bool has_image = false;
-  // Cached PNG encodings of tiles, so many watchers encode each tile version once.
-  std::vector<std::string> tile_png;
-  std::vector<uint64_t> tile_png_version;
+
+  // PNG encodings shared by every client (event_stream.cpp): each region version, and the whole
+  // image once a pass, is encoded once however many ask. Guarded by encode_mutex, never held by the
+  // render threads; taken before `mutex` when both are needed.
+  std::mutex encode_mutex;
+  std::vector<std::shared_ptr<const std::string>> region_event;  // a region's SSE tile event, less its id
+  std::vector<uint64_t> region_event_version;
+  std::string image_png;  // the whole display image
+  int image_png_width = 0, image_png_height = 0;
+  uint64_t image_png_pass = ~uint64_t(0), image_png_version = 0;
+  double image_png_time = 0;  // steady seconds when it was encoded
 };
 
 struct ManagerConfig {
@@ -110,6 +123,7 @@ class JobManager {
   void load_persisted();
 
   ManagerConfig m_config;
+  std::unique_ptr<DataDirLock> m_lock;  // held from start() on: one server per data folder
   SceneLibrary m_scenes;
   std::unique_ptr<RenderBackend> m_backend;
   mutable std::mutex m_mutex;

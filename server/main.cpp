@@ -1,7 +1,10 @@
 // render-server: the job queue behind an HTTP API, serving web/ at /.
 #include <httplib.h>
 #include <signal.h>
+#include <sys/resource.h>
 
+#include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -20,6 +23,8 @@ const char* kUsage =
     "Usage: render-server [options]\n"
     "Renders queued path-tracing jobs and serves the API (/api) and the web page (/).\n"
     "  --host ADDR       address to bind (default 127.0.0.1; 0.0.0.0 opens it to the network)\n"
+    "  --allowed-host NAME  a Host name to answer besides loopback names and --host (a reverse\n"
+    "                    proxy's name); repeatable. Other names get 421 (DNS-rebinding defence)\n"
     "  --port N          port (default 8080; 0 picks a free one and prints it)\n"
     "  --data DIR        jobs and images (default ./data)\n"
     "  --scenes DIR      a folder of .dae scenes; repeatable (default: the bundled scenes/)\n"
@@ -35,7 +40,8 @@ const char* kUsage =
     "                    the number of workers)\n"
     "  --token T         require 'Authorization: Bearer T' on /api (all but /api/health); also read\n"
     "                    from the environment variable RENDER_SERVER_TOKEN. The page asks for it.\n"
-    "  --max-connections N  open connections before new ones are answered 503 (default 128)\n"
+    "  --max-connections N  open connections before new ones are answered 503 (default 128; kept\n"
+    "                    below the process's file-descriptor limit)\n"
     "  --read-timeout SEC   seconds to receive a whole request, however slowly sent (default 10)\n"
     "  -h, --help        this text\n";
 
@@ -55,6 +61,42 @@ bool parse_int(const char* s, long lo, long hi, long* out) {
   return true;
 }
 
+// Raises the soft descriptor limit to the hard one, and keeps the connection cap below it with room
+// for the files, scenes and images jobs open: a connection flood must never leave a finished render
+// unable to write its image.
+int connection_cap(int wanted, int threads) {
+  rlimit lim{};
+  if (getrlimit(RLIMIT_NOFILE, &lim) != 0) return wanted;
+  if (lim.rlim_cur < lim.rlim_max) {
+    rlimit raised = lim;
+    raised.rlim_cur = lim.rlim_max == RLIM_INFINITY ? std::max<rlim_t>(lim.rlim_cur, 1 << 16) : lim.rlim_max;
+    if (setrlimit(RLIMIT_NOFILE, &raised) == 0) lim = raised;
+  }
+  long reserve = 64 + 4L * threads;  // job files, scene reads, image writes, Embree/TBB, logs
+  long room = lim.rlim_cur == RLIM_INFINITY ? wanted : long(lim.rlim_cur) - reserve;
+  if (room >= wanted) return wanted;
+  int cap = int(std::max(1L, room / 2));  // an accepted socket and, briefly, what serving it opens
+  std::fprintf(stderr, "render-server: --max-connections %d lowered to %d: the descriptor limit is %llu\n", wanted, cap,
+               (unsigned long long)lim.rlim_cur);
+  return cap;
+}
+
+// The Host names answered: loopback names, the bound name and --allowed-host; on a non-loopback
+// bind every name unless --allowed-host restricts them.
+srv::HostPolicy host_policy(const std::string& bind, const std::vector<std::string>& allowed) {
+  srv::HostPolicy policy;
+  std::string b = bind;
+  for (char& c : b) c = char(std::tolower((unsigned char)c));
+  policy.loopback_only = srv::is_loopback_host(b);
+  for (std::string name : allowed) {
+    for (char& c : name) c = char(std::tolower((unsigned char)c));
+    policy.allowed.push_back(name);
+  }
+  if (b != "0.0.0.0" && b != "::" && !policy.allowed.empty()) policy.allowed.push_back(b);
+  if (policy.loopback_only) policy.allowed.push_back(b);
+  return policy;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -63,6 +105,7 @@ int main(int argc, char** argv) {
   srv::ManagerConfig cfg;
   cfg.threads = int(std::max(1u, std::thread::hardware_concurrency()));
   bool scenes_given = false;
+  std::vector<std::string> allowed_hosts;
   srv::ApiOptions api;
   api.openapi = kOpenApiJson;
   if (const char* t = std::getenv("RENDER_SERVER_TOKEN")) api.token = t;
@@ -80,6 +123,7 @@ int main(int argc, char** argv) {
       std::exit(2);
     };
     if (a == "--host") host = value();
+    else if (a == "--allowed-host") allowed_hosts.push_back(value());
     else if (a == "--port") { const char* v = value(); if (!parse_int(v, 0, 65535, &port)) bad(v); }
     else if (a == "--data") cfg.data_dir = value();
     else if (a == "--scenes") { cfg.scene_dirs.push_back(value()); scenes_given = true; }
@@ -110,11 +154,12 @@ int main(int argc, char** argv) {
   srv::JobManager jobs(cfg);
   try {
     pt::require_image_io();  // every job ends in an image: refuse to start rather than lose them
-    jobs.start();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "render-server: %s\n", e.what());
     return 1;
   }
+  api.limits.max_connections = connection_cap(api.limits.max_connections, cfg.threads);
+  api.hosts = host_policy(host, allowed_hosts);
 
   // One thread per open connection (event streams hold theirs): the pool outnumbers the connection
   // cap, so connections over it are answered 503 at once instead of queueing.
@@ -125,16 +170,31 @@ int main(int argc, char** argv) {
   svr.set_keep_alive_max_count(100);
   svr.set_keep_alive_timeout(1);  // an idle connection holds up a shutdown this long at most
   svr.set_tcp_nodelay(true);  // headers and body go out in two writes: without it, +40 ms (delayed ACK)
+  // Only SO_REUSEADDR: httplib's default SO_REUSEPORT lets a second server bind the same port and
+  // silently take half its connections.
+  svr.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   srv::install_routes(svr, jobs, api);
   if (!svr.set_mount_point("/", web)) std::fprintf(stderr, "render-server: warning: no web page at %s\n", web.c_str());
 
+  errno = 0;
   int bound = port == 0 ? svr.bind_to_any_port(host) : (svr.bind_to_port(host, int(port)) ? int(port) : -1);
   if (bound < 0) {
-    std::fprintf(stderr, "render-server: cannot listen on %s:%ld\n", host.c_str(), port);
-    jobs.stop();
+    std::string why = errno ? std::strerror(errno) : "the address cannot be bound";
+    std::fprintf(stderr, "render-server: cannot listen on %s:%ld: %s%s\n", host.c_str(), port, why.c_str(),
+                 errno == EADDRINUSE ? " (is another render-server running on that port?)" : "");
     return 1;
   }
   svr.widen_backlog();
+  // Jobs start once the port is ours: a second server refused above has touched nothing.
+  try {
+    jobs.start();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "render-server: %s\n", e.what());
+    return 1;
+  }
   std::printf("render-server: listening on http://%s:%d/ (rendering: %s)\n", host.c_str(), bound,
               jobs.backend_name().c_str());
   std::fflush(stdout);

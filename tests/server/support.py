@@ -101,7 +101,7 @@ class Contract:
         if op is None:  # no such endpoint, or a method the path does not take
             if not path.startswith("/api/"):
                 return
-            assert resp.status_code in (400, 401, 404, 405, 408, 411, 413, 414, 431, 503), what
+            assert resp.status_code in (400, 401, 403, 404, 405, 408, 411, 413, 414, 415, 416, 421, 431, 501, 503), what
             assert media == "application/json", f"{what}: Content-Type {media!r}"
         else:
             documented = op["responses"]
@@ -460,11 +460,17 @@ def tonemap_course(v):
     return int(min(max(t, 0.0), 1.0) * 255.0)
 
 
+def stream_tile_size(tile_size):
+    return tile_size * -(-64 // tile_size)
+
+
 class Canvas:
     """An RGB image painted from the event stream's image and tile events."""
 
     def __init__(self, width, height, tile_size):
-        self.width, self.height, self.tile_size = width, height, tile_size
+        # The stream sends squares of whole render tiles, at least 64 pixels a side (the status's
+        # stream_tile_size), whatever tile size the job renders with.
+        self.width, self.height, self.tile_size = width, height, stream_tile_size(tile_size)
         self.pixels = bytearray(width * height * 3)
         self.painted = set()
 

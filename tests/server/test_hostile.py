@@ -134,7 +134,9 @@ def test_multipart_upload_is_415(srv):
 def test_content_type_variants_that_are_json(srv):
     for ct in ("application/json; charset=utf-8", "Application/JSON"):
         srv.api.request("POST", "/api/jobs/check", 200, data=json.dumps(TINY), headers={"Content-Type": ct})
-    srv.api.request("POST", "/api/jobs/check", 200, data=json.dumps(TINY))  # no Content-Type: read as JSON
+    # No Content-Type is not JSON: a form or a text/plain body a page of another site may send
+    # without asking must never be read as a job (CSRF).
+    srv.api.error(srv.api.request("POST", "/api/jobs/check", data=json.dumps(TINY), headers={"Content-Type": None}), 415)
 
 
 @pytest.mark.parametrize("endpoint", ["/api/jobs", "/api/jobs/check"])
@@ -182,8 +184,8 @@ VALID = json.dumps({"scene": "cornell", "width": 8, "height": 8, "spp": 1}).enco
 # its connection (its unread bytes must not be parsed as a next request): checked for every 4xx here.
 RAW = [
     ("lower-case method", b"get /api/health HTTP/1.1\r\n" + H + b"\r\n", 400),
-    ("unknown method", b"FOO /api/health HTTP/1.1\r\n" + H + b"\r\n", 400),
-    ("TRACE", b"TRACE /api/health HTTP/1.1\r\n" + H + b"\r\n", 400),
+    ("unknown method", b"FOO /api/health HTTP/1.1\r\n" + H + b"\r\n", 501),
+    ("TRACE", b"TRACE /api/health HTTP/1.1\r\n" + H + b"\r\n", 405),
     ("CONNECT", b"CONNECT 127.0.0.1:80 HTTP/1.1\r\n" + H + b"\r\n", 400),
     ("HTTP/2.0 preface", b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n", 400),
     ("HTTP/2.0 version", b"GET /api/health HTTP/2.0\r\n" + H + b"\r\n", 400),

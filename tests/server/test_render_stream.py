@@ -34,6 +34,7 @@ def test_stream_tiles_then_images_match_the_cli(server, tmp_path, name):
     api.delete(f"/api/jobs/{blocker['id']}", expect=200)
 
     canvas = Canvas(spec["width"], spec["height"], spec["tile_size"])
+    assert job["stream_tile_size"] == canvas.tile_size >= 64
     states, tiles, last_id = ["queued"], 0, first.id
     events = stream.until_end()
     for ev in events:

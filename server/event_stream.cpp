@@ -1,0 +1,235 @@
+// The event stream and the shared encodings of a job's image: see event_stream.h.
+#include "event_stream.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+
+#include "image.h"
+
+namespace srv {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double steady_seconds() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
+
+std::string base64(const std::string& in) {
+  static const char* tbl = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    uint32_t v = (uint8_t(in[i]) << 16) | (uint8_t(in[i + 1]) << 8) | uint8_t(in[i + 2]);
+    out += tbl[v >> 18];
+    out += tbl[(v >> 12) & 63];
+    out += tbl[(v >> 6) & 63];
+    out += tbl[v & 63];
+  }
+  if (i + 1 == in.size()) {
+    uint32_t v = uint8_t(in[i]) << 16;
+    out += tbl[v >> 18];
+    out += tbl[(v >> 12) & 63];
+    out += "==";
+  } else if (i + 2 == in.size()) {
+    uint32_t v = (uint8_t(in[i]) << 16) | (uint8_t(in[i + 1]) << 8);
+    out += tbl[v >> 18];
+    out += tbl[(v >> 12) & 63];
+    out += tbl[(v >> 6) & 63];
+    out += '=';
+  }
+  return out;
+}
+
+std::string sse(const std::string& event, const json& data, uint64_t id) {
+  return "id: " + std::to_string(id) + "\nevent: " + event + "\ndata: " + dump_json(data) + "\n\n";
+}
+
+// 8-bit RGB of a w x h rectangle of the job's display image; job.mutex must be held.
+std::vector<uint8_t> copy_display(const Job& job, int x, int y, int w, int h) {
+  std::vector<uint8_t> rgb(size_t(w) * h * 3);
+  for (int r = 0; r < h; ++r)
+    std::memcpy(&rgb[size_t(r) * w * 3], &job.display[(size_t(y + r) * job.width + x) * 3], size_t(w) * 3);
+  return rgb;
+}
+
+// The tile events for the regions of `job` newer than `sent` (which is brought up to date), each
+// region version encoded once for every watcher. The job's mutex is held only to copy pixels.
+std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, std::vector<uint64_t>& sent) {
+  struct Stale {
+    size_t index;
+    uint64_t version;
+    int x, y, w, h;
+    std::vector<uint8_t> rgb;
+  };
+  std::vector<std::pair<size_t, uint64_t>> changed;
+  std::vector<Stale> stale;
+  std::lock_guard<std::mutex> encoding(job.encode_mutex);
+  {
+    std::lock_guard<std::mutex> lock(job.mutex);
+    size_t n = job.region_version.size();
+    if (job.region_event.size() != n) {
+      job.region_event.assign(n, nullptr);
+      job.region_event_version.assign(n, 0);
+    }
+    if (sent.size() != n) sent.assign(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+      uint64_t v = job.region_version[i];
+      if (v <= sent[i]) continue;
+      changed.push_back({i, v});
+      if (job.region_event_version[i] == v) continue;
+      int x = int(i % size_t(job.regions_x)) * job.region_size, y = int(i / size_t(job.regions_x)) * job.region_size;
+      int w = std::min(job.region_size, job.width - x), h = std::min(job.region_size, job.height - y);
+      stale.push_back({i, v, x, y, w, h, copy_display(job, x, y, w, h)});
+    }
+  }
+  for (Stale& s : stale) {
+    char head[128];
+    std::snprintf(head, sizeof head, "event: tile\ndata: {\"x\":%d,\"y\":%d,\"w\":%d,\"h\":%d,\"png\":\"", s.x, s.y, s.w,
+                  s.h);
+    job.region_event[s.index] =
+        std::make_shared<const std::string>(head + base64(pt::encode_png8(s.rgb, s.w, s.h)) + "\"}\n\n");
+    job.region_event_version[s.index] = s.version;
+  }
+  std::vector<std::shared_ptr<const std::string>> events;
+  for (auto [i, v] : changed) {
+    events.push_back(job.region_event[i]);
+    sent[i] = v;
+  }
+  return events;
+}
+
+struct Snapshot {
+  std::string png;
+  int width = 0, height = 0;
+  uint64_t version = 0;  // the job version the picture shows
+};
+
+// A long pass still refreshes the whole-image PNG, at most this often.
+constexpr double kImageRefreshSeconds = 1.0;
+
+Snapshot snapshot_png(Job& job) {
+  std::lock_guard<std::mutex> encoding(job.encode_mutex);
+  std::vector<uint8_t> rgb;
+  Snapshot s;
+  uint64_t pass;
+  {
+    std::lock_guard<std::mutex> lock(job.mutex);
+    if (!job.has_image) return s;
+    bool same_pass = job.image_png_pass == job.passes;
+    if (job.image_png_version == job.version ||
+        (same_pass && steady_seconds() - job.image_png_time < kImageRefreshSeconds))
+      return {job.image_png, job.image_png_width, job.image_png_height, job.image_png_version};
+    rgb = copy_display(job, 0, 0, job.width, job.height);
+    s.width = job.width;
+    s.height = job.height;
+    s.version = job.version;
+    pass = job.passes;
+  }
+  s.png = pt::encode_png8(rgb, s.width, s.height);  // outside the mutex the render threads take
+  job.image_png = s.png;
+  job.image_png_width = s.width;
+  job.image_png_height = s.height;
+  job.image_png_pass = pass;
+  job.image_png_version = s.version;
+  job.image_png_time = steady_seconds();
+  return s;
+}
+
+void run_stream(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::DataSink& sink) {
+  std::vector<uint64_t> sent;
+  uint64_t seen = 0;
+  bool first = true;
+  // Watchers cost the renderer CPU: tiles are batched per round (a round at most every 40 ms) and
+  // a status event goes out at most every 250 ms unless the state changes.
+  const auto round_gap = std::chrono::milliseconds(40), status_gap = std::chrono::milliseconds(250);
+  Clock::time_point last_status;
+  std::string last_state;
+  auto write = [&](const std::string& s) { return sink.write(s.data(), s.size()); };
+  if (!write("retry: 2000\n\n")) return;
+  for (;;) {
+    json status;
+    uint64_t version;
+    bool final_state, has_image = false, png_on_disk = false;
+    int width = 0, height = 0;
+    {
+      std::unique_lock<std::mutex> lock(job->mutex);
+      bool changed = job->changed.wait_for(lock, std::chrono::seconds(15),
+                                           [&] { return job->version != seen || jobs.stopping(); });
+      if (jobs.stopping()) return;
+      if (!changed) {
+        lock.unlock();
+        if (!write(": keep-alive\n\n")) return;
+        continue;
+      }
+      version = job->version;
+      final_state = is_final(job->state);
+      if (first || final_state || last_state != job_state_name(job->state) || Clock::now() - last_status >= status_gap) {
+        status = jobs.status_json(*job, false);
+        if (!job->history.empty()) {
+          const ErrorPoint& p = job->history.back();
+          status["error_point"] = {{"seconds", p.seconds}, {"spp", p.spp}, {"error", p.error}};
+        }
+        last_state = job_state_name(job->state);
+        last_status = Clock::now();
+      }
+      has_image = job->has_image;
+      png_on_disk = !has_image && job->state == JobState::done;  // finished before a restart
+      width = job->width;
+      height = job->height;
+    }
+    if (first) {
+      // A late or reconnecting client starts from the current picture.
+      Snapshot snap;
+      if (png_on_disk) {
+        read_file(jobs.job_dir(job->id) + "/image.png", snap.png);
+        snap = {snap.png, width, height, version};
+      } else if (has_image) {
+        snap = snapshot_png(*job);
+      }
+      if (!snap.png.empty()) {
+        if (!write(sse("image", {{"width", snap.width}, {"height", snap.height}, {"png", base64(snap.png)}}, version)))
+          return;
+        std::lock_guard<std::mutex> lock(job->mutex);
+        sent.assign(job->region_version.size(), 0);
+        for (size_t i = 0; i < sent.size(); ++i) sent[i] = std::min(job->region_version[i], snap.version);
+      }
+      first = false;
+    }
+    if (!status.is_null() && !write(sse("status", status, version))) return;
+    // The id is this round's version, not the region's: ids never go back within a stream.
+    const std::string id = "id: " + std::to_string(version) + "\n";
+    std::vector<std::shared_ptr<const std::string>> tiles = changed_regions(*job, sent);
+    for (const auto& event : tiles)
+      if (!write(id) || !write(*event)) return;
+    seen = version;
+    if (final_state) {
+      write(sse("end", {{"state", status["state"]}}, version));
+      return;
+    }
+    // After a round that sent tiles, let more accumulate, but wake at once for a change of state.
+    if (tiles.empty()) continue;
+    std::unique_lock<std::mutex> lock(job->mutex);
+    job->changed.wait_for(lock, round_gap, [&] {
+      return last_state != job_state_name(job->state) || is_final(job->state) || jobs.stopping();
+    });
+  }
+}
+
+}  // namespace
+
+void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::DataSink& sink) {
+  try {
+    run_stream(jobs, job, sink);
+  } catch (const std::exception& e) {  // out of memory, an encoder failure: this stream ends, not the server
+    std::fprintf(stderr, "render-server: job %s: an event stream ended: %s\n", job->id.c_str(), e.what());
+  } catch (...) {
+    std::fprintf(stderr, "render-server: job %s: an event stream ended on an unknown error\n", job->id.c_str());
+  }
+}
+
+std::string current_png(Job& job) { return snapshot_png(job).png; }
+
+}  // namespace srv

@@ -1,0 +1,112 @@
+// JobStateSink: carries a render backend's reports (start, tiles, passes) into a Job's state under
+// its mutex, and wakes the job's watchers.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <functional>
+
+#include "image.h"
+#include "jobs.h"
+#include "render_backend.h"
+
+namespace srv {
+
+double now_unix_seconds();
+
+class JobStateSink : public JobSink {
+ public:
+  JobStateSink(Job& job, std::function<void(Job&)> persist) : m_job(job), m_persist(std::move(persist)) {}
+
+  void started(int width, int height, const std::vector<std::string>& features) override {
+    Job& j = m_job;
+    {
+      std::lock_guard<std::mutex> lock(j.mutex);
+      if (j.cancel) throw ApiError(409, "cancelled");
+      j.state = JobState::running;
+      j.started_at = now_unix_seconds();
+      j.width = width;
+      j.height = height;
+      j.tile_size = j.spec.params.tile_size;
+      j.region_size = stream_tile_size(j.tile_size);
+      j.regions_x = (width + j.region_size - 1) / j.region_size;
+      j.regions_y = (height + j.region_size - 1) / j.region_size;
+      size_t n = size_t(width) * height;
+      j.linear.assign(n * 3, 0.0f);
+      j.display.assign(n * 3, 0);
+      j.region_version.assign(size_t(j.regions_x) * j.regions_y, 0);
+      j.samples = 0;
+      j.history.clear();
+      j.has_image = false;
+      j.features = features;
+      ++j.version;
+      m_persist(j);
+    }
+    m_start = std::chrono::steady_clock::now();
+    m_last_persist = m_start;
+    j.changed.notify_all();
+  }
+
+  void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean) override {
+    Job& j = m_job;
+    {
+      std::lock_guard<std::mutex> lock(j.mutex);
+      size_t k = 0;
+      for (int y = t.y0; y < t.y1; ++y)
+        for (int x = t.x0; x < t.x1; ++x, ++k) {
+          size_t i = (size_t(y) * j.width + x) * 3;
+          for (int c = 0; c < 3; ++c) {
+            j.linear[i + c] = mean[k][c];
+            j.display[i + c] = pt::tonemap_course(mean[k][c]);
+          }
+        }
+      j.region_version[size_t(t.y0 / j.region_size) * j.regions_x + t.x0 / j.region_size] = ++j.version;
+      j.has_image = true;
+      j.elapsed = seconds();
+    }
+    // Every notify wakes every watcher, and each takes the job's mutex the render threads need:
+    // tile updates wake them at most every kTileNotifyGap (watchers batch tiles over 40 ms rounds
+    // anyway); pass() and state changes, which always follow the tiles, wake them at once.
+    int64_t now = std::chrono::steady_clock::now().time_since_epoch().count(), last = m_last_notify.load();
+    if (now - last >= kTileNotifyGap && m_last_notify.compare_exchange_strong(last, now)) j.changed.notify_all();
+  }
+
+  void pass(const RenderReport& r) override {
+    Job& j = m_job;
+    {
+      std::lock_guard<std::mutex> lock(j.mutex);
+      j.samples = r.samples;
+      j.rays = r.rays;
+      j.nonfinite = r.nonfinite;
+      j.elapsed = seconds();
+      j.progress = r.progress;
+      if (std::isfinite(r.error)) {
+        j.error_estimate = r.error;
+        j.history.push_back({j.elapsed, double(r.samples) / (double(j.width) * j.height), r.error});
+      }
+      pt::RunLimits limits;
+      limits.target_error = j.spec.target_error;
+      limits.time_limit = j.spec.time_limit;
+      j.eta = pt::remaining_seconds(j.elapsed, j.progress, r.error, j.elapsed, limits);
+      ++j.version;
+      ++j.passes;
+      if (std::chrono::steady_clock::now() - m_last_persist > std::chrono::seconds(1)) {
+        m_persist(j);
+        m_last_persist = std::chrono::steady_clock::now();
+      }
+    }
+    j.changed.notify_all();
+  }
+
+ private:
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count(); }
+  Job& m_job;
+  std::function<void(Job&)> m_persist;
+  std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last_persist = m_start;
+  static constexpr int64_t kTileNotifyGap =
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::milliseconds(20)).count();
+  std::atomic<int64_t> m_last_notify{0};
+};
+
+}  // namespace srv
