@@ -21,7 +21,13 @@ namespace pt {
 namespace collada_detail {
 
 // User text quoted in a message, cut short: an id or URL of a megabyte must not become the message.
-inline std::string clip(const std::string& s, size_t n = 60) { return s.size() <= n ? s : s.substr(0, n) + "..."; }
+// The cut never splits a UTF-8 character (a Blender export's long Japanese object name would
+// otherwise make the message invalid UTF-8).
+inline std::string clip(const std::string& s, size_t n = 60) {
+  if (s.size() <= n) return s;
+  for (int back = 0; back < 3 && n > 0 && (static_cast<unsigned char>(s[n]) & 0xc0) == 0x80; ++back) --n;
+  return s.substr(0, n) + "...";
+}
 
 class Reader {
  public:

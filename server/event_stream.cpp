@@ -2,6 +2,7 @@
 #include "event_stream.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +14,13 @@ namespace srv {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+std::atomic<uint64_t> g_watchers{0}, g_png_encodes{0}, g_tile_events{0};
+
+std::string encode_png(const std::vector<uint8_t>& rgb, int w, int h) {
+  ++g_png_encodes;
+  return pt::encode_png8(rgb, w, h);
+}
 
 double steady_seconds() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 
@@ -55,9 +63,15 @@ std::vector<uint8_t> copy_display(const Job& job, int x, int y, int w, int h) {
   return rgb;
 }
 
+// A region's encoding younger than this is sent to watchers as it is, though the region has changed
+// since: watchers that wake at different moments share one encoding instead of each asking for the
+// newest version. The changes reach them in a later round; a job's last round is always exact.
+constexpr double kRegionRefreshSeconds = 0.1;
+
 // The tile events for the regions of `job` newer than `sent` (which is brought up to date), each
-// region version encoded once for every watcher. The job's mutex is held only to copy pixels.
-std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, std::vector<uint64_t>& sent) {
+// region encoded once for every watcher. The job's mutex is held only to copy pixels. `exact`:
+// every region at its current version (the stream's last round).
+std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, std::vector<uint64_t>& sent, bool exact) {
   struct Stale {
     size_t index;
     uint64_t version;
@@ -73,13 +87,18 @@ std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, std::v
     if (job.region_event.size() != n) {
       job.region_event.assign(n, nullptr);
       job.region_event_version.assign(n, 0);
+      job.region_event_time.assign(n, 0.0);
     }
     if (sent.size() != n) sent.assign(n, 0);
+    double now = steady_seconds();
     for (size_t i = 0; i < n; ++i) {
-      uint64_t v = job.region_version[i];
+      uint64_t v = job.region_version[i], cached = job.region_event_version[i];
       if (v <= sent[i]) continue;
+      if (cached == v || (!exact && cached > sent[i] && now - job.region_event_time[i] < kRegionRefreshSeconds)) {
+        changed.push_back({i, cached});
+        continue;
+      }
       changed.push_back({i, v});
-      if (job.region_event_version[i] == v) continue;
       int x = int(i % size_t(job.regions_x)) * job.region_size, y = int(i / size_t(job.regions_x)) * job.region_size;
       int w = std::min(job.region_size, job.width - x), h = std::min(job.region_size, job.height - y);
       stale.push_back({i, v, x, y, w, h, copy_display(job, x, y, w, h)});
@@ -90,8 +109,9 @@ std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, std::v
     std::snprintf(head, sizeof head, "event: tile\ndata: {\"x\":%d,\"y\":%d,\"w\":%d,\"h\":%d,\"png\":\"", s.x, s.y, s.w,
                   s.h);
     job.region_event[s.index] =
-        std::make_shared<const std::string>(head + base64(pt::encode_png8(s.rgb, s.w, s.h)) + "\"}\n\n");
+        std::make_shared<const std::string>(head + base64(encode_png(s.rgb, s.w, s.h)) + "\"}\n\n");
     job.region_event_version[s.index] = s.version;
+    job.region_event_time[s.index] = steady_seconds();
   }
   std::vector<std::shared_ptr<const std::string>> events;
   for (auto [i, v] : changed) {
@@ -128,7 +148,7 @@ Snapshot snapshot_png(Job& job) {
     s.version = job.version;
     pass = job.passes;
   }
-  s.png = pt::encode_png8(rgb, s.width, s.height);  // outside the mutex the render threads take
+  s.png = encode_png(rgb, s.width, s.height);  // outside the mutex the render threads take
   job.image_png = s.png;
   job.image_png_width = s.width;
   job.image_png_height = s.height;
@@ -201,9 +221,11 @@ void run_stream(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::Data
     if (!status.is_null() && !write(sse("status", status, version))) return;
     // The id is this round's version, not the region's: ids never go back within a stream.
     const std::string id = "id: " + std::to_string(version) + "\n";
-    std::vector<std::shared_ptr<const std::string>> tiles = changed_regions(*job, sent);
-    for (const auto& event : tiles)
+    std::vector<std::shared_ptr<const std::string>> tiles = changed_regions(*job, sent, final_state);
+    for (const auto& event : tiles) {
       if (!write(id) || !write(*event)) return;
+      ++g_tile_events;
+    }
     seen = version;
     if (final_state) {
       write(sse("end", {{"state", status["state"]}}, version));
@@ -221,6 +243,10 @@ void run_stream(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::Data
 }  // namespace
 
 void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::DataSink& sink) {
+  struct Count {
+    Count() { ++g_watchers; }
+    ~Count() { --g_watchers; }
+  } count;
   try {
     run_stream(jobs, job, sink);
   } catch (const std::exception& e) {  // out of memory, an encoder failure: this stream ends, not the server
@@ -231,5 +257,7 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
 }
 
 std::string current_png(Job& job) { return snapshot_png(job).png; }
+
+StreamStats stream_stats() { return {g_watchers.load(), g_png_encodes.load(), g_tile_events.load()}; }
 
 }  // namespace srv

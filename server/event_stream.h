@@ -20,4 +20,10 @@ void stream_events(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::D
 // published pass however many clients ask. Empty when the job has no image yet.
 std::string current_png(Job& job);
 
+// What serving images has cost since start (for /api/health).
+struct StreamStats {
+  uint64_t watchers = 0, png_encodes = 0, tile_events = 0;
+};
+StreamStats stream_stats();
+
 }  // namespace srv

@@ -122,6 +122,9 @@ void install_guards(httplib::Server& svr, const ApiOptions& options) {
     // httplib 0.11 builds a multi-range answer whole in memory, however many ranges are asked for
     // (Range: bytes=0-,0-,... multiplies a file): one range at most, on every route.
     if (req.get_header_value_count("Range") > 1 || count_ranges(req.get_header_value("Range")) > 1) {
+      // httplib applies the parsed ranges to whatever answer goes out, this refusal included. The
+      // Request is httplib's own non-const object, handed to this hook as const: clearing is safe.
+      const_cast<httplib::Request&>(req).ranges.clear();
       res.set_header("Content-Range", "bytes */*");
       return refuse(416, "only a single byte range is served");
     }
@@ -197,13 +200,12 @@ void install_guards(httplib::Server& svr, const ApiOptions& options) {
     } else if (failure == ReadFailure::body_too_large && (res.status == 400 || res.status == 413)) {
       send_error(res, 413, "the request body exceeds the limit of " + std::to_string(max_body / 1024) + " KiB");
     }
-    // httplib answers a well-formed request with a method it does not serve 400: TRACE is a method
-    // this server refuses (405), an unknown token one it does not implement (501).
+    // httplib answers a well-formed request with a method it does not serve (TRACE, QUERY, ...)
+    // 400: it is 405, with the methods that are.
     if (res.status == 400 && failure == ReadFailure::none && well_formed_unknown_method(req)) {
-      bool trace = req.method == "TRACE";
       std::string allow = allowed_methods(req.path);
       res.set_header("Allow", allow.empty() ? "GET, HEAD" : allow);
-      send_error(res, trace ? 405 : 501, req.method + (trace ? " is not allowed here" : " is not a method this server implements"));
+      send_error(res, 405, req.method + " is not allowed here (allowed: " + (allow.empty() ? "GET, HEAD" : allow) + ")");
       close_after_response();  // httplib read no body for it: none may be parsed as the next request
       res.set_header("Connection", "close");
     }

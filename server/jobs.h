@@ -67,6 +67,7 @@ struct Job {
   std::mutex encode_mutex;
   std::vector<std::shared_ptr<const std::string>> region_event;  // a region's SSE tile event, less its id
   std::vector<uint64_t> region_event_version;
+  std::vector<double> region_event_time;  // steady seconds when each was encoded
   std::string image_png;  // the whole display image
   int image_png_width = 0, image_png_height = 0;
   uint64_t image_png_pass = ~uint64_t(0), image_png_version = 0;

@@ -22,6 +22,8 @@ void install_routes(httplib::Server& svr, JobManager& jobs, const ApiOptions& op
       running += j->state == JobState::running;
     }
     json health{{"status", "ok"}, {"queued", queued}, {"running", running}, {"rendering", jobs.backend_name()}};
+    StreamStats st = stream_stats();
+    health["stream"] = {{"watchers", st.watchers}, {"png_encodes", st.png_encodes}, {"tile_events", st.tile_events}};
     int workers = jobs.live_workers();
     if (workers >= 0) health["workers"] = workers;
     send_json(res, 200, health);

@@ -192,14 +192,41 @@ json SceneLibrary::list() {
   json out = json::array();
   for (const std::string& name : names) {
     json item{{"name", name}};
-    try {
-      uint64_t hash = 0;
-      item["summary"] = summary(name, &hash);
+    // Each file is parsed once per (path, size, modification time): a broken scene of 86 MB must
+    // not be parsed again on every listing.
+    std::string path = resolve(name);
+    struct stat st {};
+    bool known = !path.empty() && stat(path.c_str(), &st) == 0;
+    FileStamp stamp{path, st.st_size, st.st_mtim.tv_sec, st.st_mtim.tv_nsec};
+    FileSummary cached;
+    bool hit = false;
+    if (known) {
       std::lock_guard<std::mutex> lock(m_mutex);
-      auto it = m_cache.find(hash);
+      auto it = m_file_summaries.find(name);
+      if (it != m_file_summaries.end() && it->second.stamp == stamp) {
+        cached = it->second;
+        hit = true;
+      }
+    }
+    if (!hit) {
+      cached.stamp = stamp;
+      try {
+        cached.summary = summary(name, &cached.hash);
+      } catch (const std::exception& e) {
+        cached.error = e.what();
+      }
+      if (known) {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        m_file_summaries[name] = cached;
+      }
+    }
+    if (!cached.error.empty()) {
+      item["error"] = cached.error;
+    } else {
+      item["summary"] = cached.summary;
+      std::lock_guard<std::mutex> lock(m_mutex);
+      auto it = m_cache.find(cached.hash);
       if (it != m_cache.end() && it->second.bytes > 0) item["memory_bytes"] = it->second.bytes;
-    } catch (const std::exception& e) {
-      item["error"] = e.what();
     }
     out.push_back(item);
   }

@@ -54,7 +54,23 @@ class SceneLibrary {
   // free once it has released the lock.
   void evict_over_budget(uint64_t keep, std::vector<std::shared_future<Base>>& dropped);
 
+  // What list() last found in a scene file, valid while the file keeps its path, size and time.
+  struct FileStamp {
+    std::string path;
+    long long size = 0, mtime_s = 0, mtime_ns = 0;
+    bool operator==(const FileStamp& o) const {
+      return path == o.path && size == o.size && mtime_s == o.mtime_s && mtime_ns == o.mtime_ns;
+    }
+  };
+  struct FileSummary {
+    FileStamp stamp;
+    json summary;       // when it loads
+    std::string error;  // when it does not
+    uint64_t hash = 0;
+  };
+
   std::vector<std::string> m_dirs;  // canonical
+  std::map<std::string, FileSummary> m_file_summaries;  // by scene name
   size_t m_cache_bytes;
   std::mutex m_mutex;
   std::map<uint64_t, Entry> m_cache;            // by content hash

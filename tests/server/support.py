@@ -190,15 +190,17 @@ class Api:
 class Server:
     """`token`: started with --token and its Api sends it; `env`: extra environment; `limit_file_kib`:
     the process may write files of at most that size (ulimit -f: a disk that fills up);
-    `limit_memory_mib`: its address space (ulimit -v: memory that runs out)."""
+    `limit_memory_mib`: its address space (ulimit -v: memory that runs out); `limit_open_files`: its
+    file descriptors (ulimit -n, soft and hard)."""
 
     def __init__(self, root, contract, threads=1, args=(), scenes=None, token=None, env=None, limit_file_kib=None,
-                 limit_memory_mib=None):
+                 limit_memory_mib=None, limit_open_files=None):
         self.root = Path(root)
         self.token = token
         self.env = env
         self.limit_file_kib = limit_file_kib
         self.limit_memory_mib = limit_memory_mib
+        self.limit_open_files = limit_open_files
         self.data = self.root / "data"
         self.scenes = Path(scenes) if scenes else self.root / "scenes"
         self.contract = contract
@@ -219,6 +221,8 @@ class Server:
             limits.append(f"ulimit -f {int(self.limit_file_kib)}")
         if self.limit_memory_mib is not None:
             limits.append(f"ulimit -v {int(self.limit_memory_mib) * 1024}")
+        if self.limit_open_files is not None:
+            limits.append(f"ulimit -n {int(self.limit_open_files)}")
         if limits:  # bash sets the limits, then becomes the server (same pid)
             cmd = ["bash", "-c", " && ".join(limits) + ' && exec "$0" "$@"', *cmd]
         env = dict(os.environ, **self.env) if self.env else None
@@ -458,6 +462,12 @@ def tonemap_course(v):
         return 0
     t = (1.41421356 * v) ** (1 / 2.2)
     return int(min(max(t, 0.0), 1.0) * 255.0)
+
+
+def health_counts(health):
+    """/api/health without its running totals ("stream"), which every request may move."""
+    assert set(health["stream"]) == {"watchers", "png_encodes", "tile_events"}, health
+    return {k: v for k, v in health.items() if k != "stream"}
 
 
 def stream_tile_size(tile_size):

@@ -184,7 +184,7 @@ VALID = json.dumps({"scene": "cornell", "width": 8, "height": 8, "spp": 1}).enco
 # its connection (its unread bytes must not be parsed as a next request): checked for every 4xx here.
 RAW = [
     ("lower-case method", b"get /api/health HTTP/1.1\r\n" + H + b"\r\n", 400),
-    ("unknown method", b"FOO /api/health HTTP/1.1\r\n" + H + b"\r\n", 501),
+    ("unknown method", b"FOO /api/health HTTP/1.1\r\n" + H + b"\r\n", 405),
     ("TRACE", b"TRACE /api/health HTTP/1.1\r\n" + H + b"\r\n", 405),
     ("CONNECT", b"CONNECT 127.0.0.1:80 HTTP/1.1\r\n" + H + b"\r\n", 400),
     ("HTTP/2.0 preface", b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n", 400),
