@@ -34,7 +34,7 @@ const char* kUsage =
     "                    to render-worker processes through Redis Streams (docs/scale-out.md)\n"
     "  --units-in-flight N  Redis: passes queued ahead of the merges per job (default 4; about\n"
     "                    the number of workers)\n"
-    "  --redis-timeout SEC  Redis: how long a job waits for an unreachable Redis before failing (default 300)\n"
+    "  --redis-timeout SEC  Redis: seconds a job waits for an unreachable Redis, then fails (default 300)\n"
     "  --token T         require 'Authorization: Bearer T' on /api (all but /api/health); also read\n"
     "                    from the environment variable RENDER_SERVER_TOKEN. The page asks for it.\n"
     "  --max-connections N  open connections before new ones are answered 503 (default 128)\n"

@@ -181,7 +181,8 @@ class RedisBackend : public RenderBackend {
         bool fresh = redis.command({"HSET", job_key, "spec", spec_json, "scene", scene_hash}).integer_value > 0;
         redis.command({"EXPIRE", job_key, ttl});
         if (fresh && plan.issued() > merged.size()) {
-          std::fprintf(stderr, "render-server: job %s: the run's keys were gone from Redis; issuing its %zu unmerged passes again\n",
+          std::fprintf(stderr,
+                       "render-server: job %s: the run's keys were gone from Redis; issuing its %zu unmerged passes again\n",
                        job.id.c_str(), plan.issued() - merged.size());
           for (size_t u = 0; u < plan.issued(); ++u)
             if (!merged.count(uint32_t(u))) issue(u);

@@ -127,7 +127,8 @@ class Worker {
   // group; any other is thrown.
   bool lost_group(const RedisReply& r) {
     if (r.type != RedisReply::error) return false;
-    if (r.str.rfind("NOGROUP", 0) != 0) throw RedisError("Redis at " + m_address.url() + ": " + valid_utf8(r.str, 1000));
+    if (r.str.rfind("NOGROUP", 0) != 0)
+      throw RedisError("Redis at " + m_address.url() + ": " + valid_utf8(r.str, 1000));
     rq::ensure_group(m_redis);
     return true;
   }
@@ -160,11 +161,13 @@ class Worker {
   }
 
   void dead_letter(const rq::WorkItem& item, const std::string& why, int tries) {
-    const std::string range = "[" + std::to_string(item.first) + ", " + std::to_string(uint64_t(item.first) + item.count) + ")";
+    const std::string range =
+        "[" + std::to_string(item.first) + ", " + std::to_string(uint64_t(item.first) + item.count) + ")";
     RedisReply r = m_redis.command({"XADD", rq::kDeadStream, "MAXLEN", "~", std::to_string(rq::kDeadStreamLength), "*",
                                     "job", item.job, "run", item.run, "unit", std::to_string(item.unit), "first",
                                     std::to_string(item.first), "count", std::to_string(item.count), "entry",
-                                    item.entry_id, "worker", m_opt.name, "deliveries", std::to_string(tries), "reason", why},
+                                    item.entry_id, "worker", m_opt.name, "deliveries", std::to_string(tries),
+                                    "reason", why},
                                    true);
     if (r.type == RedisReply::error)  // the job still fails, below
       std::fprintf(stderr, "render-worker %s: cannot add to %s: %s\n", m_opt.name.c_str(), rq::kDeadStream.c_str(),
@@ -252,7 +255,8 @@ class Worker {
         return it->second;
       }
     RedisReply text = m_redis.command({"GET", rq::scene_key(hash)});
-    if (text.type != RedisReply::string) throw std::runtime_error("the scene of job '" + name + "' is no longer in Redis");
+    if (text.type != RedisReply::string)
+      throw std::runtime_error("the scene of job '" + name + "' is no longer in Redis");
     auto t0 = std::chrono::steady_clock::now();
     auto base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(pt::parse_collada(text.str, name + ".dae")));
     log("scene '%s' built in %.3f s", name.c_str(),
