@@ -360,7 +360,7 @@ bool parse_options(int argc, char** argv, Options& o) {
       if (!(o.claim_timeout >= 0.2 && o.claim_timeout <= 3600)) throw std::invalid_argument("--claim-timeout must be 0.2-3600 s");
     } else if (a == "--redis-timeout") {
       o.redis_timeout = std::atof(value().c_str());
-      if (!(o.redis_timeout >= 0.1 && o.redis_timeout <= 86400)) throw std::invalid_argument("--redis-timeout must be 0.1-86400 s");
+      if (!(o.redis_timeout >= 0.1 && o.redis_timeout <= 3600)) throw std::invalid_argument("--redis-timeout must be 0.1-3600 s");
     } else if (a == "--quiet") {
       o.quiet = true;
     } else {
