@@ -13,6 +13,7 @@
 #include "connection.h"
 #include "image.h"
 #include "jobs.h"
+#include "render_backend.h"
 #include "routes.h"
 
 extern const char* kOpenApiJson;  // generated from server/openapi.json at build time
@@ -38,6 +39,7 @@ const char* kUsage =
     "                    to render-worker processes through Redis Streams (docs/scale-out.md)\n"
     "  --units-in-flight N  Redis: passes queued ahead of the merges per job (default 4; about\n"
     "                    the number of workers)\n"
+    "  --redis-timeout SEC  Redis: seconds a job waits for an unreachable Redis, then fails (default 300)\n"
     "  --token T         require 'Authorization: Bearer T' on /api (all but /api/health); also read\n"
     "                    from the environment variable RENDER_SERVER_TOKEN. The page asks for it.\n"
     "  --max-connections N  open connections before new ones are answered 503 (default 128; kept\n"
@@ -134,6 +136,7 @@ int main(int argc, char** argv) {
     else if (a == "--max-queue") { const char* v = value(); if (!parse_int(v, 0, 100000, &n)) bad(v); cfg.max_queue = size_t(n); }
     else if (a == "--queue") cfg.queue = value();
     else if (a == "--units-in-flight") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.units_in_flight = int(n); }
+    else if (a == "--redis-timeout") { const char* v = value(); double t; if (!parse_seconds(v, &t)) bad(v); srv::set_redis_timeout(t); }
     else if (a == "--token") api.token = value();
     else if (a == "--max-connections") { const char* v = value(); if (!parse_int(v, 1, 10000, &n)) bad(v); api.limits.max_connections = int(n); }
     else if (a == "--read-timeout") { const char* v = value(); if (!parse_seconds(v, &api.limits.request_timeout)) bad(v); }

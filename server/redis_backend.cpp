@@ -1,9 +1,10 @@
 // The Redis backend: a job becomes sample passes on the stream pt:work; render-workers render them
 // and return per-pixel sums on the run's results stream, which are merged here as they arrive
 // (pt::FilmAccumulator) and stream to the page like the embedded renderer's tiles.
+#include <atomic>
 #include <chrono>
-#include <mutex>
 #include <cstdio>
+#include <mutex>
 #include <random>
 #include <set>
 
@@ -85,6 +86,21 @@ class PassPlan {
   std::vector<std::pair<uint32_t, uint32_t>> m_ranges;
 };
 
+// The features a worker reports: comma-separated names from Redis, so bounded and made valid UTF-8.
+std::vector<std::string> parse_features(const std::string* text) {
+  std::vector<std::string> out;
+  if (!text) return out;
+  for (size_t at = 0; at < text->size() && out.size() < 64;) {
+    size_t comma = text->find(',', at);
+    if (comma == std::string::npos) comma = text->size();
+    out.push_back(valid_utf8(std::string_view(*text).substr(at, comma - at), 64));
+    at = comma + 1;
+  }
+  return out;
+}
+
+std::atomic<double> g_redis_timeout{300};
+
 class RedisBackend : public RenderBackend {
  public:
   RedisBackend(SceneLibrary& scenes, const std::string& url, int in_flight)
@@ -117,20 +133,18 @@ class RedisBackend : public RenderBackend {
     const int w = p.cell_w > 0 ? p.cell_w : p.width, h = p.cell_w > 0 ? p.cell_h : p.height;
     const size_t pixels = size_t(w) * h;
 
-    RedisClient redis(m_address);
+    // An unreachable Redis (a restart) is waited for, up to --redis-timeout; a cancel ends the wait.
+    RedisClient redis(m_address, 5.0, false);
+    redis.set_patience(g_redis_timeout.load(), &stop, "render-server: job " + job.id);
     const std::string run = new_run_id(), job_key = rq::job_key(job.id, run), results = rq::results_key(job.id, run);
-    // The scene's bytes go up once per content: repeated jobs on a large scene send only its hash.
     const std::string scene_hash = rq::content_hash(scene_text), ttl = std::to_string(rq::kKeyTtlSeconds);
-    redis.command({"SET", rq::scene_key(scene_hash), scene_text, "EX", ttl, "NX"});
-    redis.command({"EXPIRE", rq::scene_key(scene_hash), ttl});
-    std::string().swap(scene_text);
-    redis.command({"HSET", job_key, "spec", job_spec_to_json(spec).dump(), "scene", scene_hash});
-    redis.command({"EXPIRE", job_key, ttl});
+    const std::string spec_json = job_spec_to_json(spec).dump();
     struct Cleanup {  // however the render ends, workers learn the run is over
       RedisClient& redis;
       std::string job_key, results;
       ~Cleanup() {
         try {
+          redis.set_patience(0);
           redis.command({"DEL", job_key, results});
         } catch (const std::exception& e) {
           std::fprintf(stderr, "render-server: cannot clean up %s: %s\n", job_key.c_str(), e.what());
@@ -145,90 +159,117 @@ class RedisBackend : public RenderBackend {
       for (int x = 0; x < w; x += p.tile_size) tiles.push_back({x, y, std::min(x + p.tile_size, w), std::min(y + p.tile_size, h)});
 
     std::set<uint32_t> merged;
+    std::string last_id = "0-0";
+    auto issue = [&](size_t unit) {
+      auto [first, count] = plan.range(unit);
+      redis.command({"XADD", rq::kWorkStream, "*", "job", job.id, "run", run, "unit", std::to_string(unit), "first",
+                     std::to_string(first), "count", std::to_string(count), "mask",
+                     p.adaptive ? pt::pack_mask(film.done()) : std::string()});
+    };
+    // Puts what workers need in Redis: the group, the scene's bytes (once per content: repeated
+    // jobs on a large scene send only its hash), the run's hash. Again on every new connection:
+    // a Redis restarted without its data has lost them, and the passes issued so far, which go
+    // out again (a pass rendered twice is merged once).
+    uint64_t published = ~uint64_t(0);  // the connection the run was last published on (none yet)
+    auto publish = [&] {
+      do {
+        redis.command({"PING"});
+        published = redis.connections();
+        rq::ensure_group(redis);
+        redis.command({"SET", rq::scene_key(scene_hash), scene_text, "EX", ttl, "NX"});
+        redis.command({"EXPIRE", rq::scene_key(scene_hash), ttl});
+        bool fresh = redis.command({"HSET", job_key, "spec", spec_json, "scene", scene_hash}).integer_value > 0;
+        redis.command({"EXPIRE", job_key, ttl});
+        if (fresh && plan.issued() > merged.size()) {
+          std::fprintf(stderr,
+                       "render-server: job %s: the run's keys were gone from Redis; issuing its %zu unmerged passes again\n",
+                       job.id.c_str(), plan.issued() - merged.size());
+          for (size_t u = 0; u < plan.issued(); ++u)
+            if (!merged.count(uint32_t(u))) issue(u);
+        }
+        if (fresh) last_id = "0-0";  // results of the lost stream that came in again
+      } while (redis.connections() != published);
+    };
+
     int workers = 1;
     auto next_worker_count = clock::now();
     bool started = false;
-    std::string last_id = "0-0";
     double merge_seconds = 0;  // decoding, merging and publishing passes: the server's cost per pass
     size_t pass_bytes = 0;
     auto t0 = clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(clock::now() - t0).count(); };
     RenderResult result;
-    redis.set_timeout(5.0);
-    for (;;) {
-      // Keep every live worker busy plus a few passes queued, each carrying the pixels converged
-      // so far. The worker count is looked up at most once a second.
-      if (clock::now() >= next_worker_count) {
-        workers = std::max(1, live_workers());
-        next_worker_count = clock::now() + std::chrono::seconds(1);
-      }
-      const size_t ahead = size_t(std::max(m_in_flight, workers + 2));
-      while (!plan.exhausted() && plan.issued() < merged.size() + ahead && !film.finished()) {
-        auto [first, count] = plan.next(film.remaining(), workers);
-        redis.command({"XADD", rq::kWorkStream, "*", "job", job.id, "run", run, "unit", std::to_string(plan.issued() - 1),
-                       "first", std::to_string(first), "count", std::to_string(count), "mask",
-                       p.adaptive ? pt::pack_mask(film.done()) : std::string()});
-      }
-      if (stop) {
-        result.why = pt::StopReason::cancelled;
-        break;
-      }
-      if (spec.time_limit > 0 && elapsed() >= spec.time_limit && !merged.empty()) {
-        result.why = pt::StopReason::time_limit;
-        break;
-      }
-      RedisReply r = redis.command({"XREAD", "COUNT", "4", "BLOCK", "100", "STREAMS", results, last_id});
-      if (r.is_nil() || r.elements.empty() || r.elements[0].elements.size() < 2) continue;
-      auto merge_start = clock::now();
-      bool changed = false;
-      for (const RedisReply& e : r.elements[0].elements[1].elements) {
-        if (e.elements.size() != 2) continue;
-        last_id = e.elements[0].str;
-        const RedisReply& body = e.elements[1];
-        if (const std::string* err = body.field("error")) throw std::runtime_error(*err);
-        const std::string *unit = body.field("unit"), *bytes = body.field("pass");
-        if (!unit || !bytes) continue;
-        uint32_t u = uint32_t(std::strtoul(unit->c_str(), nullptr, 10));
-        if (u >= plan.issued() || merged.count(u)) continue;  // a pass rendered twice (its first worker looked dead)
-        pt::FilmPass pass = pt::FilmPass::decode(*bytes, w, h);
-        pass_bytes += bytes->size();
-        if (pass.first != plan.range(u).first || pass.count != plan.range(u).second) continue;
-        uint64_t pass_samples = 0;
-        for (uint32_t n : pass.samples) pass_samples += n;
-        plan.observe(pass_samples, pass.seconds);
-        if (!started) {
-          std::vector<std::string> features;
-          if (const std::string* f = body.field("features"))
-            for (size_t at = 0; at < f->size();) {
-              size_t comma = f->find(',', at);
-              if (comma == std::string::npos) comma = f->size();
-              features.push_back(f->substr(at, comma - at));
-              at = comma + 1;
-            }
-          sink.started(w, h, features);
-          started = true;
+    try {
+      for (;;) {
+        // Keep every live worker busy plus a few passes queued, each carrying the pixels converged
+        // so far. The worker count is looked up at most once a second.
+        if (redis.connections() != published) publish();
+        if (clock::now() >= next_worker_count) {
+          workers = std::max(1, live_workers());
+          next_worker_count = clock::now() + std::chrono::seconds(1);
         }
-        film.merge(pass);
-        merged.insert(u);
-        changed = true;
+        const size_t ahead = size_t(std::max(m_in_flight, workers + 2));
+        while (!plan.exhausted() && plan.issued() < merged.size() + ahead && !film.finished()) {
+          plan.next(film.remaining(), workers);
+          issue(plan.issued() - 1);
+        }
+        if (stop) {
+          result.why = pt::StopReason::cancelled;
+          break;
+        }
+        if (spec.time_limit > 0 && elapsed() >= spec.time_limit && !merged.empty()) {
+          result.why = pt::StopReason::time_limit;
+          break;
+        }
+        RedisReply r = redis.command({"XREAD", "COUNT", "4", "BLOCK", "100", "STREAMS", results, last_id});
+        // Everything read from Redis is checked: [[stream, [[id, [field, value, ...]], ...]]].
+        if (r.type != RedisReply::array || r.elements.empty() || r.elements[0].elements.size() < 2) continue;
+        auto merge_start = clock::now();
+        bool changed = false;
+        for (const RedisReply& e : r.elements[0].elements[1].elements) {
+          if (e.elements.size() != 2 || e.elements[0].type != RedisReply::string) continue;
+          last_id = e.elements[0].str;
+          const RedisReply& body = e.elements[1];
+          if (const std::string* err = body.field("error")) throw std::runtime_error(valid_utf8(*err, 2000));
+          const std::string* bytes = body.field("pass");
+          uint32_t u = 0;
+          if (!rq::parse_u32(body.field("unit"), u) || !bytes) continue;
+          if (u >= plan.issued() || merged.count(u)) continue;  // a pass rendered twice (its first worker looked dead)
+          pt::FilmPass pass = pt::FilmPass::decode(*bytes, w, h);
+          pass_bytes += bytes->size();
+          if (pass.first != plan.range(u).first || pass.count != plan.range(u).second) continue;
+          uint64_t pass_samples = 0;
+          for (uint32_t n : pass.samples) pass_samples += n;
+          plan.observe(pass_samples, pass.seconds);
+          if (!started) {
+            sink.started(w, h, parse_features(body.field("features")));
+            started = true;
+          }
+          film.merge(pass);
+          merged.insert(u);
+          changed = true;
+        }
+        if (!changed) continue;
+        std::vector<pt::Vec3> buf;
+        for (const pt::Tile& t : tiles) {
+          film.read_tile(t, buf);
+          sink.tile(t, buf);
+        }
+        result.report = {film.progress(), film.samples(), film.rays(), film.nonfinite(), film.error_estimate()};
+        sink.pass(result.report);
+        merge_seconds += std::chrono::duration<double>(clock::now() - merge_start).count();
+        if (spec.target_error > 0 && result.report.error <= spec.target_error) {
+          result.why = pt::StopReason::target_error;
+          break;
+        }
+        if (film.finished() || (plan.exhausted() && merged.size() == plan.issued())) {
+          result.why = pt::StopReason::finished;
+          break;
+        }
       }
-      if (!changed) continue;
-      std::vector<pt::Vec3> buf;
-      for (const pt::Tile& t : tiles) {
-        film.read_tile(t, buf);
-        sink.tile(t, buf);
-      }
-      result.report = {film.progress(), film.samples(), film.rays(), film.nonfinite(), film.error_estimate()};
-      sink.pass(result.report);
-      merge_seconds += std::chrono::duration<double>(clock::now() - merge_start).count();
-      if (spec.target_error > 0 && result.report.error <= spec.target_error) {
-        result.why = pt::StopReason::target_error;
-        break;
-      }
-      if (film.finished() || (plan.exhausted() && merged.size() == plan.issued())) {
-        result.why = pt::StopReason::finished;
-        break;
-      }
+    } catch (const RedisUnreachable&) {
+      if (!stop) throw;  // away past --redis-timeout: the job fails, saying so
+      result.why = pt::StopReason::cancelled;  // cancelled (or the server stopping) while waiting
     }
     if (!started && result.why != pt::StopReason::cancelled) sink.started(w, h, {});
     result.image = film.image();
@@ -253,6 +294,8 @@ class RedisBackend : public RenderBackend {
 };
 
 }  // namespace
+
+void set_redis_timeout(double seconds) { g_redis_timeout = seconds; }
 
 std::unique_ptr<RenderBackend> make_redis_backend(SceneLibrary& scenes, const std::string& url, int units_in_flight) {
   return std::make_unique<RedisBackend>(scenes, url, units_in_flight);

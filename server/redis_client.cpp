@@ -2,7 +2,10 @@
 
 #include <hiredis/hiredis.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <thread>
 
 namespace srv {
 
@@ -45,11 +48,48 @@ RedisReply convert(const redisReply* r) {
   return out;
 }
 
+// "CMD key" for messages: the command and, when short, its first argument (usually the key).
+std::string describe(const std::vector<std::string>& args) {
+  std::string s = args.empty() ? "" : args[0];
+  if (args.size() > 1 && args[1].size() <= 64) s += " " + args[1];
+  return valid_utf8(s, 200);
+}
+
 }  // namespace
+
+std::string valid_utf8(std::string_view s, size_t max_bytes) {
+  if (s.size() > max_bytes) s = s.substr(0, max_bytes);
+  std::string out;
+  out.reserve(s.size());
+  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
+  const size_t n = s.size();
+  for (size_t i = 0; i < n;) {
+    // Well-formed sequences as in the Unicode standard's table 3-7 (no overlongs, surrogates or
+    // code points past U+10FFFF): the lead byte fixes the length and the second byte's range.
+    const unsigned char c = p[i];
+    size_t len = 0;
+    unsigned char lo = 0x80, hi = 0xBF;
+    if (c < 0x80) len = 1;
+    else if (c >= 0xC2 && c <= 0xDF) len = 2;
+    else if (c >= 0xE0 && c <= 0xEF) len = 3, lo = c == 0xE0 ? 0xA0 : 0x80, hi = c == 0xED ? 0x9F : 0xBF;
+    else if (c >= 0xF0 && c <= 0xF4) len = 4, lo = c == 0xF0 ? 0x90 : 0x80, hi = c == 0xF4 ? 0x8F : 0xBF;
+    bool ok = len > 0 && i + len <= n;
+    for (size_t k = 1; ok && k < len; ++k) ok = k == 1 ? p[i + k] >= lo && p[i + k] <= hi : (p[i + k] & 0xC0) == 0x80;
+    if (ok) {
+      out.append(s.data() + i, len);
+      i += len;
+    } else {
+      out += "\xEF\xBF\xBD";  // U+FFFD
+      ++i;
+    }
+  }
+  return out;
+}
 
 const std::string* RedisReply::field(const std::string& name) const {
   for (size_t i = 0; i + 1 < elements.size(); i += 2)
-    if (elements[i].str == name) return &elements[i + 1].str;
+    if (elements[i].type == string && elements[i].str == name && elements[i + 1].type == string)
+      return &elements[i + 1].str;
   return nullptr;
 }
 
@@ -74,25 +114,38 @@ RedisAddress RedisAddress::parse(const std::string& url) {
   return a;
 }
 
-RedisClient::RedisClient(RedisAddress address, double timeout_seconds)
+RedisClient::RedisClient(RedisAddress address, double timeout_seconds, bool connect_now)
     : m_address(std::move(address)), m_timeout(timeout_seconds) {
-  connect();
+  if (connect_now) connect();
 }
 
 RedisClient::~RedisClient() {
   if (m_ctx) redisFree(m_ctx);
 }
 
-void RedisClient::connect() {
+bool RedisClient::open(std::string& why) {
   if (m_ctx) redisFree(m_ctx);
   m_ctx = redisConnectWithTimeout(m_address.host.c_str(), m_address.port, to_timeval(m_timeout));
   if (!m_ctx || m_ctx->err) {
-    std::string why = m_ctx ? m_ctx->errstr : "out of memory";
+    why = m_ctx ? valid_utf8(m_ctx->errstr, 200) : "out of memory";
     if (m_ctx) redisFree(m_ctx);
     m_ctx = nullptr;
-    throw RedisError("cannot reach Redis at " + m_address.url() + ": " + why);
+    return false;
   }
   redisSetTimeout(m_ctx, to_timeval(m_timeout));
+  ++m_connections;
+  return true;
+}
+
+void RedisClient::connect() {
+  std::string why;
+  if (!open(why)) throw RedisUnreachable("cannot reach Redis at " + m_address.url() + ": " + why);
+}
+
+void RedisClient::set_patience(double seconds, const std::atomic<bool>* abort, std::string who) {
+  m_patience = std::max(0.0, seconds);
+  m_abort = abort;
+  m_who = std::move(who);
 }
 
 void RedisClient::set_timeout(double seconds) {
@@ -101,27 +154,56 @@ void RedisClient::set_timeout(double seconds) {
 }
 
 RedisReply RedisClient::command(const std::vector<std::string>& args, bool allow_error) {
+  using clock = std::chrono::steady_clock;
   std::vector<const char*> argv;
   std::vector<size_t> lens;
   for (const std::string& a : args) {
     argv.push_back(a.data());
     lens.push_back(a.size());
   }
+  auto aborted = [&] { return m_abort && m_abort->load(); };
+  clock::time_point lost;
+  double wait = 0.1;
   for (int attempt = 0;; ++attempt) {
-    if (!m_ctx) connect();
-    auto* r = static_cast<redisReply*>(redisCommandArgv(m_ctx, int(argv.size()), argv.data(), lens.data()));
-    if (!r) {
-      std::string why = m_ctx->errstr;
-      redisFree(m_ctx);
-      m_ctx = nullptr;
-      if (attempt == 0) continue;
-      throw RedisError("Redis at " + m_address.url() + ": " + args[0] + ": " + why);
+    std::string why;
+    if (m_ctx || open(why)) {
+      auto* r = static_cast<redisReply*>(redisCommandArgv(m_ctx, int(argv.size()), argv.data(), lens.data()));
+      if (r) {
+        RedisReply out = convert(r);
+        freeReplyObject(r);
+        // A Redis restarting with its data answers LOADING until it has read it: wait as for a restart.
+        if (out.type != RedisReply::error || out.str.rfind("LOADING", 0) != 0) {
+          if (attempt > 1 && !m_who.empty())
+            std::fprintf(stderr, "%s: Redis at %s is back after %.1f s\n", m_who.c_str(), m_address.url().c_str(),
+                         std::chrono::duration<double>(clock::now() - lost).count());
+          if (out.type == RedisReply::error && !allow_error)
+            throw RedisError("Redis at " + m_address.url() + ": " + describe(args) + ": " + valid_utf8(out.str, 1000));
+          return out;
+        }
+        why = valid_utf8(out.str, 200);
+      } else {
+        why = valid_utf8(m_ctx->errstr, 200);
+        redisFree(m_ctx);
+        m_ctx = nullptr;
+      }
     }
-    RedisReply out = convert(r);
-    freeReplyObject(r);
-    if (out.type == RedisReply::error && !allow_error)
-      throw RedisError("Redis at " + m_address.url() + ": " + args[0] + ": " + out.str);
-    return out;
+    if (attempt == 0) {  // a connection Redis closed (idle, restarted): reopen it at once
+      lost = clock::now();
+      continue;
+    }
+    const double gone = std::chrono::duration<double>(clock::now() - lost).count();
+    if (gone >= m_patience || aborted()) {
+      char buf[64] = "";
+      if (m_patience > 0 && !aborted()) std::snprintf(buf, sizeof buf, " was unreachable for %g s", m_patience);
+      throw RedisUnreachable("Redis at " + m_address.url() + buf + ": " + describe(args) + ": " + why);
+    }
+    if (attempt == 1 && !m_who.empty())
+      std::fprintf(stderr, "%s: lost Redis at %s (%s); retrying for up to %g s\n", m_who.c_str(),
+                   m_address.url().c_str(), why.c_str(), m_patience);
+    // Back-off: 0.1 s doubling to 2 s, in short steps so that an abort is seen at once.
+    auto until = clock::now() + std::chrono::duration<double>(std::min(wait, m_patience - gone));
+    while (clock::now() < until && !aborted()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    wait = std::min(2 * wait, 2.0);
   }
 }
 

@@ -1,14 +1,24 @@
 #include "redis_queue.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 
 namespace srv::rq {
 
 void ensure_group(RedisClient& redis) {
-  RedisReply r = redis.command({"XGROUP", "CREATE", kWorkStream, kGroup, "$", "MKSTREAM"}, true);
+  RedisReply r = redis.command({"XGROUP", "CREATE", kWorkStream, kGroup, "0", "MKSTREAM"}, true);
   if (r.type == RedisReply::error && r.str.rfind("BUSYGROUP", 0) != 0)
     throw RedisError("Redis at " + redis.address().url() + ": cannot create the consumer group: " + r.str);
+}
+
+int delivery_count(RedisClient& redis, const std::string& entry_id) {
+  // The extended form answers [[id, consumer, idle ms, deliveries]] for a pending entry.
+  RedisReply r = redis.command({"XPENDING", kWorkStream, kGroup, entry_id, entry_id, "1"}, true);
+  if (r.type != RedisReply::array || r.elements.size() != 1) return 0;
+  const RedisReply& e = r.elements[0];
+  if (e.type != RedisReply::array || e.elements.size() != 4 || e.elements[3].type != RedisReply::integer) return 0;
+  return int(std::min<long long>(std::max<long long>(e.elements[3].integer_value, 0), 1 << 30));
 }
 
 int count_workers(RedisClient& redis) {
@@ -23,22 +33,22 @@ int count_workers(RedisClient& redis) {
   return n;
 }
 
-namespace {
-
 bool parse_u32(const std::string* s, uint32_t& out) {
   if (!s || s->empty() || s->size() > 10) return false;
-  char* end = nullptr;
-  unsigned long long v = std::strtoull(s->c_str(), &end, 10);
-  if (*end || v > 0xffffffffull) return false;
+  uint64_t v = 0;
+  for (char c : *s) {
+    if (c < '0' || c > '9') return false;  // strtoull would take a sign, spaces and a NUL's early end
+    v = v * 10 + uint64_t(c - '0');
+  }
+  if (v > 0xffffffffull) return false;
   out = uint32_t(v);
   return true;
 }
 
-}  // namespace
-
 bool parse_work_item(const RedisReply& entry, WorkItem& out) {
   // An entry is [id, [field, value, ...]]; an entry deleted while pending has a nil body.
-  if (entry.type != RedisReply::array || entry.elements.size() != 2) return false;
+  if (entry.type != RedisReply::array || entry.elements.size() != 2 || entry.elements[0].type != RedisReply::string)
+    return false;
   out = WorkItem();
   out.entry_id = entry.elements[0].str;
   const RedisReply& body = entry.elements[1];

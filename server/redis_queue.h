@@ -9,6 +9,8 @@
 //                           encoding, features) or failures (unit, worker, error)
 //   pt:worker:<name>        a live worker's presence (its thread count), expiring kWorkerTtlSeconds
 //                           after its last heartbeat
+//   pt:dead                 stream of passes set aside after kMaxDeliveries failed tries (job, run,
+//                           unit, first, count, entry, worker, deliveries, reason), capped in length
 // A run is one attempt at a job: a server restart starts a new run, and anything left of an
 // older one is ignored.
 #pragma once
@@ -36,8 +38,17 @@ inline std::string worker_key(const std::string& name) { return "pt:worker:" + n
 // Counts the live workers' keys (SCAN, so a large keyspace is walked in steps).
 int count_workers(RedisClient& redis);
 
-// Creates the stream and the consumer group if missing (idempotent).
+// Creates the stream and the consumer group if missing (idempotent). A group created over an
+// existing stream starts at its beginning, so passes added before it (a restarted Redis) are read.
 void ensure_group(RedisClient& redis);
+
+// Passes that failed this many deliveries (or whose workers died on them that often) go to
+// kDeadStream instead of being tried again, and their job fails.
+inline const std::string kDeadStream = "pt:dead";
+constexpr int kMaxDeliveries = 3;
+constexpr int kDeadStreamLength = 10000;  // entries kept, about
+// How many times the pending pass `entry_id` has been delivered (XPENDING); 0 if it is not pending.
+int delivery_count(RedisClient& redis, const std::string& entry_id);
 
 struct WorkItem {
   std::string entry_id;
@@ -45,6 +56,9 @@ struct WorkItem {
   uint32_t unit = 0, first = 0, count = 0;
   std::string mask;  // packed bits; empty: no pixel converged yet
 };
+
+// A decimal uint32 (no sign, no spaces, at most 10 digits); false for anything else or null.
+bool parse_u32(const std::string* s, uint32_t& out);
 
 // A stream entry's fields as a work item; false when a field is missing or malformed.
 bool parse_work_item(const RedisReply& entry, WorkItem& out);

@@ -1,6 +1,8 @@
 // render-worker: takes sample passes from Redis (stream pt:work, consumer group "workers"),
 // renders them and returns per-pixel sums. Work a dead worker held is claimed by a live one once
-// it has been idle for --claim-timeout; a live worker keeps its pass fresh by re-claiming it.
+// it has been idle for --claim-timeout; a live worker keeps its pass fresh by re-claiming it. A
+// pass that fails kMaxDeliveries tries goes to the dead-letter stream and fails its job. An
+// unreachable Redis (a restart) is waited for, up to --redis-timeout.
 #include <signal.h>
 #include <unistd.h>
 
@@ -32,6 +34,7 @@ const char* kUsage =
     "  -t, --threads N      render threads (default: all cores)\n"
     "  --name NAME          consumer name in the group (default: host-pid)\n"
     "  --claim-timeout SEC  take over passes a worker left unacknowledged this long (default 10)\n"
+    "  --redis-timeout SEC  wait this long for an unreachable Redis, then exit (default 300)\n"
     "  --quiet              log nothing but errors\n"
     "  -h, --help           this text\n";
 
@@ -43,6 +46,7 @@ struct Options {
   int threads = int(std::max(1u, std::thread::hardware_concurrency()));
   std::string name;
   double claim_timeout = 10;
+  double redis_timeout = 300;
   bool quiet = false;
 };
 
@@ -60,35 +64,54 @@ constexpr size_t kRunsKept = 4, kBasesKept = 2;
 
 class Worker {
  public:
-  explicit Worker(Options o) : m_opt(std::move(o)), m_address(RedisAddress::parse(m_opt.queue)), m_redis(m_address) {
+  explicit Worker(Options o)
+      : m_opt(std::move(o)), m_address(RedisAddress::parse(m_opt.queue)), m_redis(m_address, 5.0, false) {
+    m_redis.set_patience(m_opt.redis_timeout, &g_stop, "render-worker " + m_opt.name);
     rq::ensure_group(m_redis);
+    m_grouped = m_redis.connections();
   }
 
   void run() {
-    m_redis.set_timeout(5.0);
     while (!g_stop) {
       announce(m_redis);
+      if (m_redis.connections() != m_grouped) {  // reconnected: a restarted Redis has no group
+        rq::ensure_group(m_redis);
+        m_grouped = m_redis.connections();
+      }
       rq::WorkItem item;
       if (!next_item(item)) continue;
       handle(item);
     }
+    m_redis.set_patience(0);
     m_redis.command({"DEL", rq::worker_key(m_opt.name)});  // stopped: no longer counted
   }
 
  private:
   // A pass whose worker went quiet first (XAUTOCLAIM), else a new one (XREADGROUP, 1 s block).
+  // A pass released after a failed try is claimed at once, and counts as a delivery.
   bool next_item(rq::WorkItem& item) {
     std::string idle_ms = std::to_string(int64_t(m_opt.claim_timeout * 1000));
-    RedisReply r = m_redis.command({"XAUTOCLAIM", rq::kWorkStream, rq::kGroup, m_opt.name, idle_ms, "0-0", "COUNT", "1"});
-    if (r.elements.size() >= 2)
+    RedisReply r =
+        m_redis.command({"XAUTOCLAIM", rq::kWorkStream, rq::kGroup, m_opt.name, idle_ms, "0-0", "COUNT", "1"}, true);
+    if (lost_group(r)) return false;
+    if (r.type == RedisReply::array && r.elements.size() >= 2)
       for (const RedisReply& e : r.elements[1].elements)
         if (parse_or_drop(e, item)) {
-          log("claimed pass %u of job %s left by another worker", item.unit, item.job.c_str());
+          int deliveries = rq::delivery_count(m_redis, item.entry_id);
+          if (deliveries > rq::kMaxDeliveries) {  // its workers died on it every time: a poison pass
+            dead_letter(item, "its workers stopped without finishing it " + std::to_string(deliveries - 1) + " times",
+                        deliveries - 1);
+            return false;
+          }
+          log("claimed pass %u of job %s left by another worker or a failed try (delivery %d)", item.unit,
+              item.job.c_str(), deliveries);
           return true;
         }
     r = m_redis.command({"XREADGROUP", "GROUP", rq::kGroup, m_opt.name, "COUNT", "1", "BLOCK", "1000", "STREAMS",
-                         rq::kWorkStream, ">"});
-    if (r.is_nil() || r.elements.empty() || r.elements[0].elements.size() < 2) return false;
+                         rq::kWorkStream, ">"},
+                        true);
+    if (lost_group(r)) return false;
+    if (r.type != RedisReply::array || r.elements.empty() || r.elements[0].elements.size() < 2) return false;
     for (const RedisReply& e : r.elements[0].elements[1].elements)
       if (parse_or_drop(e, item)) return true;
     return false;
@@ -100,15 +123,66 @@ class Worker {
                    std::to_string(rq::kWorkerTtlSeconds)});
   }
 
+  // An error reply: NOGROUP (Redis restarted empty, or the stream was deleted) re-creates the
+  // group; any other is thrown.
+  bool lost_group(const RedisReply& r) {
+    if (r.type != RedisReply::error) return false;
+    if (r.str.rfind("NOGROUP", 0) != 0)
+      throw RedisError("Redis at " + m_address.url() + ": " + valid_utf8(r.str, 1000));
+    rq::ensure_group(m_redis);
+    return true;
+  }
+
   bool parse_or_drop(const RedisReply& entry, rq::WorkItem& item) {
     if (rq::parse_work_item(entry, item)) return true;
     if (entry.type == RedisReply::array && !entry.elements.empty()) acknowledge(entry.elements[0].str);
     return false;
   }
 
+  // Error replies are ignored: after a restart of Redis the entry (or the group) may be gone.
   void acknowledge(const std::string& id) {
-    m_redis.command({"XACK", rq::kWorkStream, rq::kGroup, id});
-    m_redis.command({"XDEL", rq::kWorkStream, id});
+    m_redis.command({"XACK", rq::kWorkStream, rq::kGroup, id}, true);
+    m_redis.command({"XDEL", rq::kWorkStream, id}, true);
+  }
+
+  // A try of the pass failed: released for another try (by any worker, at once), or after
+  // kMaxDeliveries tries set aside in the dead-letter stream, which fails the job.
+  void fail(const rq::WorkItem& item, const std::string& why) {
+    int deliveries = rq::delivery_count(m_redis, item.entry_id);
+    std::fprintf(stderr, "render-worker %s: job %s pass %u failed (delivery %d of %d): %s\n", m_opt.name.c_str(),
+                 item.job.c_str(), item.unit, deliveries, rq::kMaxDeliveries, why.c_str());
+    if (deliveries == 0) return;  // no longer pending (Redis restarted): nothing to release
+    if (deliveries >= rq::kMaxDeliveries) return dead_letter(item, why, deliveries);
+    // An idle time past every --claim-timeout makes the next XAUTOCLAIM take it (JUSTID: this
+    // claim is not counted as a delivery).
+    m_redis.command({"XCLAIM", rq::kWorkStream, rq::kGroup, m_opt.name, "0", item.entry_id, "IDLE",
+                     std::to_string(int64_t(3600) * 24 * 365 * 1000), "JUSTID"},
+                    true);
+  }
+
+  void dead_letter(const rq::WorkItem& item, const std::string& why, int tries) {
+    const std::string range =
+        "[" + std::to_string(item.first) + ", " + std::to_string(uint64_t(item.first) + item.count) + ")";
+    RedisReply r = m_redis.command({"XADD", rq::kDeadStream, "MAXLEN", "~", std::to_string(rq::kDeadStreamLength), "*",
+                                    "job", item.job, "run", item.run, "unit", std::to_string(item.unit), "first",
+                                    std::to_string(item.first), "count", std::to_string(item.count), "entry",
+                                    item.entry_id, "worker", m_opt.name, "deliveries", std::to_string(tries),
+                                    "reason", why},
+                                   true);
+    if (r.type == RedisReply::error)  // the job still fails, below
+      std::fprintf(stderr, "render-worker %s: cannot add to %s: %s\n", m_opt.name.c_str(), rq::kDeadStream.c_str(),
+                   valid_utf8(r.str, 1000).c_str());
+    // The server fails the job with this; the results key may itself be damaged, which the
+    // server's own read of it then reports.
+    const std::string results = rq::results_key(item.job, item.run);
+    m_redis.command({"XADD", results, "*", "unit", std::to_string(item.unit), "worker", m_opt.name, "error",
+                     "pass " + std::to_string(item.unit) + " (samples " + range + ") failed " + std::to_string(tries) +
+                         " times and was set aside in " + rq::kDeadStream + ": " + why},
+                    true);
+    m_redis.command({"EXPIRE", results, std::to_string(rq::kKeyTtlSeconds)}, true);
+    acknowledge(item.entry_id);
+    std::fprintf(stderr, "render-worker %s: job %s pass %u set aside in %s after %d tries\n", m_opt.name.c_str(),
+                 item.job.c_str(), item.unit, rq::kDeadStream.c_str(), tries);
   }
 
   void handle(const rq::WorkItem& item) {
@@ -118,6 +192,10 @@ class Worker {
         acknowledge(item.entry_id);
         return;
       }
+      const uint32_t spp = uint32_t(std::max(0, m_runs.front()->spec.params.spp));
+      if (item.first >= spp || item.count > spp - item.first)
+        throw std::runtime_error("samples [" + std::to_string(item.first) + ", +" + std::to_string(item.count) +
+                                 ") are outside the job's " + std::to_string(spp) + " spp");
       std::atomic<bool> cancel{false};
       bool complete = false;
       pt::FilmPass pass = render_with_heartbeat(item, cancel, complete);
@@ -135,13 +213,12 @@ class Worker {
       acknowledge(item.entry_id);
       log("job %s pass %u: samples [%u, %u) in %.2f s", item.job.c_str(), item.unit, item.first,
           item.first + item.count, pass.seconds);
-    } catch (const RedisError&) {
-      throw;  // the queue is gone: the caller reconnects; the pass stays pending
+    } catch (const RedisUnreachable&) {
+      throw;  // Redis stayed away past --redis-timeout, or a signal: the pass stays pending
     } catch (const std::exception& e) {
-      // The scene or spec cannot render: tell the server (which fails the job), drop the pass.
-      std::fprintf(stderr, "render-worker: job %s: %s\n", item.job.c_str(), e.what());
-      m_redis.command({"XADD", results, "*", "unit", std::to_string(item.unit), "worker", m_opt.name, "error", e.what()});
-      acknowledge(item.entry_id);
+      // The run's keys, spec or scene are unusable (a damaged key answers WRONGTYPE): try again,
+      // at most kMaxDeliveries times in all.
+      fail(item, e.what());
     }
   }
 
@@ -156,6 +233,8 @@ class Worker {
       }
     RedisReply r = m_redis.command({"HMGET", key, "spec", "scene"});
     if (r.elements.size() != 2 || r.elements[0].is_nil() || r.elements[1].is_nil()) return false;
+    if (r.elements[0].type != RedisReply::string || r.elements[1].type != RedisReply::string)
+      throw std::runtime_error(key + ": unexpected reply");
     auto run = std::make_unique<PreparedRun>();
     run->key = key;
     run->spec = parse_job_spec(json::parse(r.elements[0].str));
@@ -176,7 +255,8 @@ class Worker {
         return it->second;
       }
     RedisReply text = m_redis.command({"GET", rq::scene_key(hash)});
-    if (text.is_nil()) throw std::runtime_error("the scene of job '" + name + "' is no longer in Redis");
+    if (text.type != RedisReply::string)
+      throw std::runtime_error("the scene of job '" + name + "' is no longer in Redis");
     auto t0 = std::chrono::steady_clock::now();
     auto base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(pt::parse_collada(text.str, name + ".dae")));
     log("scene '%s' built in %.3f s", name.c_str(),
@@ -193,20 +273,23 @@ class Worker {
     std::condition_variable cv;
     bool finished = false;
     std::thread beat([&] {
-      try {
-        RedisClient hb(m_address);
-        std::string key = rq::job_key(item.job, item.run);
-        auto period = std::chrono::duration<double>(std::min(1.0, std::max(0.2, m_opt.claim_timeout / 4)));
-        std::unique_lock<std::mutex> lock(m);
-        while (!cv.wait_for(lock, period, [&] { return finished; })) {
-          lock.unlock();
-          hb.command({"XCLAIM", rq::kWorkStream, rq::kGroup, m_opt.name, "0", item.entry_id, "JUSTID"});
+      // Beats go on through a Redis outage (each a fresh try); the run's key gone cancels the pass,
+      // as after a restart of Redis that lost it (the server then issues the pass again).
+      RedisClient hb(m_address, 5.0, false);
+      std::string key = rq::job_key(item.job, item.run), last_error;
+      auto period = std::chrono::duration<double>(std::min(1.0, std::max(0.2, m_opt.claim_timeout / 4)));
+      std::unique_lock<std::mutex> lock(m);
+      while (!cv.wait_for(lock, period, [&] { return finished; })) {
+        lock.unlock();
+        try {
+          hb.command({"XCLAIM", rq::kWorkStream, rq::kGroup, m_opt.name, "0", item.entry_id, "JUSTID"}, true);
           announce(hb);
           if (hb.command({"EXISTS", key}).integer_value == 0) cancel = true;
-          lock.lock();
+        } catch (const std::exception& e) {
+          if (e.what() != last_error) std::fprintf(stderr, "render-worker: heartbeat: %s\n", e.what());
+          last_error = e.what();
         }
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "render-worker: heartbeat: %s\n", e.what());
+        lock.lock();
       }
     });
     std::thread signals([&] {  // a signal stops the pass too
@@ -250,6 +333,7 @@ class Worker {
   Options m_opt;
   RedisAddress m_address;
   RedisClient m_redis;
+  uint64_t m_grouped = 0;  // the connection on which the group was last ensured
   std::list<std::unique_ptr<PreparedRun>> m_runs;  // most recent first
   std::list<std::pair<std::string, std::shared_ptr<const pt::SceneBase>>> m_bases;
 };
@@ -274,6 +358,9 @@ bool parse_options(int argc, char** argv, Options& o) {
     } else if (a == "--claim-timeout") {
       o.claim_timeout = std::atof(value().c_str());
       if (!(o.claim_timeout >= 0.2 && o.claim_timeout <= 3600)) throw std::invalid_argument("--claim-timeout must be 0.2-3600 s");
+    } else if (a == "--redis-timeout") {
+      o.redis_timeout = std::atof(value().c_str());
+      if (!(o.redis_timeout >= 0.1 && o.redis_timeout <= 3600)) throw std::invalid_argument("--redis-timeout must be 0.1-3600 s");
     } else if (a == "--quiet") {
       o.quiet = true;
     } else {
@@ -303,17 +390,22 @@ int main(int argc, char** argv) {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
-  // The queue may restart or be briefly unreachable: reconnect with back-off until stopped.
-  for (double wait = 0.5; !g_stop; wait = std::min(wait * 2, 5.0)) {
+  // Redis unreachable is waited for inside (up to --redis-timeout); other errors (a damaged
+  // pt:work) start the worker again after a back-off.
+  for (double wait = 0.1; !g_stop; wait = std::min(wait * 2, 2.0)) {
     try {
       Worker worker(opt);
       std::fprintf(stderr, "render-worker %s: taking passes from %s with %d threads\n", opt.name.c_str(),
                    opt.queue.c_str(), opt.threads);
-      wait = 0.5;
+      wait = 0.1;
       worker.run();
     } catch (const std::invalid_argument& e) {
       std::fprintf(stderr, "render-worker: %s\n", e.what());
       return 2;
+    } catch (const RedisUnreachable& e) {
+      if (g_stop) break;
+      std::fprintf(stderr, "render-worker: %s; giving up\n", e.what());
+      return 1;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "render-worker: %s; retrying in %.1f s\n", e.what(), wait);
       for (double t = 0; t < wait && !g_stop; t += 0.1) std::this_thread::sleep_for(std::chrono::milliseconds(100));

@@ -29,9 +29,11 @@ def free_port():
 
 
 class Redis:
-    def __init__(self, root):
+    """A redis-server without persistence on a free loopback port, or on `port` (a restart)."""
+
+    def __init__(self, root, port=None):
         assert shutil.which("redis-server"), "redis-server is missing: run scripts/install-deps.sh"
-        self.port = free_port()
+        self.port = port or free_port()
         self.proc = subprocess.Popen(["redis-server", "--port", str(self.port), "--bind", "127.0.0.1", "--save", "",
                                       "--appendonly", "no", "--dir", str(root)],
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -58,12 +60,12 @@ class Redis:
 
 
 class Worker:
-    def __init__(self, root, redis_url, name):
+    def __init__(self, root, redis_url, name, args=()):
         self.name = name
         self.log_path = Path(root) / f"{name}.log"
         self.log = open(self.log_path, "wb")
         self.proc = subprocess.Popen([str(RENDER_WORKER), "--queue", redis_url, "-t", "1", "--name", name,
-                                      "--claim-timeout", "1"], stdout=self.log, stderr=self.log)
+                                      "--claim-timeout", "1", *args], stdout=self.log, stderr=self.log)
 
     def text(self):
         return self.log_path.read_text(errors="replace")
