@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Fuzzes the scene loader (parse_collada + make_render_scene, tests/fuzz_collada.cpp) with libFuzzer
-# in its own tree build-fuzz (clang, -fsanitize=fuzzer,address,undefined), seeded with scenes/,
+# Fuzzes the scene loader (parse_collada + make_render_scene, tests/fuzz_collada.cpp) and then what
+# the server interprets in a request (headers, job spec JSON, UTF-8 repair: tests/fuzz_http.cpp,
+# for half as long) with libFuzzer in its own tree build-fuzz
+# (clang, -fsanitize=fuzzer,address,undefined). The loader is seeded with scenes/,
 # ../shared/scenes-cs184/ (copied at run time: the course scenes stay out of the repository) and
 # the regression inputs. Exits non-zero on a finding: crash-*, timeout-*, oom-* in build-fuzz/findings;
 # each one fixed becomes a file in tests/fuzz-regressions/ (test_hostile_scenes loads them all).
@@ -15,7 +17,7 @@ if [ ! -f build-fuzz/build.ninja ]; then
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=address,undefined" > /dev/null
 fi
-cmake --build build-fuzz --target fuzz_collada
+cmake --build build-fuzz --target fuzz_collada fuzz_http
 corpus=build-fuzz/corpus
 mkdir -p "$corpus" build-fuzz/findings
 for seed in scenes/*.dae ../shared/scenes-cs184/*.dae tests/fuzz-regressions/*; do
@@ -28,6 +30,13 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 # -close_fd_mask=2 silences the loader's warnings; libFuzzer and sanitizer reports still print.
 # Inputs over 128 KiB (the bunny and dragon) are read truncated; -timeout and -rss_limit_mb make
 # a slow or memory-hungry input a finding.
-exec ./build-fuzz/tests/fuzz_collada -max_total_time="$seconds" -max_len=131072 -timeout=10 -rss_limit_mb=2048 \
+./build-fuzz/tests/fuzz_collada -max_total_time="$seconds" -max_len=131072 -timeout=10 -rss_limit_mb=2048 \
   -close_fd_mask=2 -dict=tests/fuzz_collada.dict -artifact_prefix=build-fuzz/findings/ -print_final_stats=1 \
   "$@" "$corpus"
+http_corpus=build-fuzz/corpus-http
+mkdir -p "$http_corpus"
+cp tests/fuzz-http-seeds/* "$http_corpus"/
+chmod u+w "$http_corpus"/*
+exec ./build-fuzz/tests/fuzz_http -max_total_time="$(( (seconds + 1) / 2 ))" -max_len=4096 -timeout=10 \
+  -rss_limit_mb=2048 -dict=tests/fuzz_http.dict -artifact_prefix=build-fuzz/findings/http- -print_final_stats=1 \
+  "$@" "$http_corpus"

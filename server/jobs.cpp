@@ -113,7 +113,7 @@ void JobManager::start() {
   if (m_config.queue.empty() || m_config.queue == "embedded")
     m_backend = make_embedded_backend(m_scenes, m_config.threads);
   else
-    m_backend = make_redis_backend(m_scenes, m_config.queue, m_config.units_in_flight);
+    m_backend = make_redis_backend(m_scenes, m_config.queue, m_config.units_in_flight, m_config.redis_timeout);
   load_persisted();
   for (int i = 0; i < std::max(1, m_config.concurrency); ++i) m_workers.emplace_back([this] { worker_loop(); });
 }

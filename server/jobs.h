@@ -84,6 +84,7 @@ struct ManagerConfig {
   SpecLimits limits;
   std::string queue = "embedded";  // or redis://host:port: render-workers do the rendering
   int units_in_flight = 4;         // Redis: sample passes queued ahead of the merges, per job
+  double redis_timeout = 300;      // Redis: seconds a job waits for an unreachable Redis
 };
 
 class JobManager {

@@ -13,7 +13,6 @@
 #include "connection.h"
 #include "image.h"
 #include "jobs.h"
-#include "render_backend.h"
 #include "routes.h"
 
 extern const char* kOpenApiJson;  // generated from server/openapi.json at build time
@@ -136,7 +135,7 @@ int main(int argc, char** argv) {
     else if (a == "--max-queue") { const char* v = value(); if (!parse_int(v, 0, 100000, &n)) bad(v); cfg.max_queue = size_t(n); }
     else if (a == "--queue") cfg.queue = value();
     else if (a == "--units-in-flight") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.units_in_flight = int(n); }
-    else if (a == "--redis-timeout") { const char* v = value(); double t; if (!parse_seconds(v, &t)) bad(v); srv::set_redis_timeout(t); }
+    else if (a == "--redis-timeout") { const char* v = value(); if (!parse_seconds(v, &cfg.redis_timeout)) bad(v); }
     else if (a == "--token") api.token = value();
     else if (a == "--max-connections") { const char* v = value(); if (!parse_int(v, 1, 10000, &n)) bad(v); api.limits.max_connections = int(n); }
     else if (a == "--read-timeout") { const char* v = value(); if (!parse_seconds(v, &api.limits.request_timeout)) bad(v); }

@@ -99,12 +99,11 @@ std::vector<std::string> parse_features(const std::string* text) {
   return out;
 }
 
-std::atomic<double> g_redis_timeout{300};
-
 class RedisBackend : public RenderBackend {
  public:
-  RedisBackend(SceneLibrary& scenes, const std::string& url, int in_flight)
-      : m_scenes(scenes), m_address(RedisAddress::parse(url)), m_in_flight(std::max(1, in_flight)) {
+  RedisBackend(SceneLibrary& scenes, const std::string& url, int in_flight, double redis_timeout)
+      : m_scenes(scenes), m_address(RedisAddress::parse(url)), m_in_flight(std::max(1, in_flight)),
+        m_redis_timeout(redis_timeout) {
     RedisClient redis(m_address);
     rq::ensure_group(redis);
   }
@@ -135,7 +134,7 @@ class RedisBackend : public RenderBackend {
 
     // An unreachable Redis (a restart) is waited for, up to --redis-timeout; a cancel ends the wait.
     RedisClient redis(m_address, 5.0, false);
-    redis.set_patience(g_redis_timeout.load(), &stop, "render-server: job " + job.id);
+    redis.set_patience(m_redis_timeout, &stop, "render-server: job " + job.id);
     const std::string run = new_run_id(), job_key = rq::job_key(job.id, run), results = rq::results_key(job.id, run);
     const std::string scene_hash = rq::content_hash(scene_text), ttl = std::to_string(rq::kKeyTtlSeconds);
     const std::string spec_json = job_spec_to_json(spec).dump();
@@ -289,16 +288,16 @@ class RedisBackend : public RenderBackend {
   SceneLibrary& m_scenes;
   RedisAddress m_address;
   int m_in_flight;
+  double m_redis_timeout;  // seconds a job waits for an unreachable Redis (--redis-timeout)
   std::mutex m_health_mutex;
   std::unique_ptr<RedisClient> m_health;
 };
 
 }  // namespace
 
-void set_redis_timeout(double seconds) { g_redis_timeout = seconds; }
-
-std::unique_ptr<RenderBackend> make_redis_backend(SceneLibrary& scenes, const std::string& url, int units_in_flight) {
-  return std::make_unique<RedisBackend>(scenes, url, units_in_flight);
+std::unique_ptr<RenderBackend> make_redis_backend(SceneLibrary& scenes, const std::string& url, int units_in_flight,
+                                                  double redis_timeout) {
+  return std::make_unique<RedisBackend>(scenes, url, units_in_flight, redis_timeout);
 }
 
 }  // namespace srv

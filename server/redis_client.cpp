@@ -1,5 +1,7 @@
 #include "redis_client.h"
 
+#include "request_policy.h"
+
 #include <hiredis/hiredis.h>
 
 #include <chrono>
@@ -58,32 +60,8 @@ std::string describe(const std::vector<std::string>& args) {
 }  // namespace
 
 std::string valid_utf8(std::string_view s, size_t max_bytes) {
-  if (s.size() > max_bytes) s = s.substr(0, max_bytes);
-  std::string out;
-  out.reserve(s.size());
-  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
-  const size_t n = s.size();
-  for (size_t i = 0; i < n;) {
-    // Well-formed sequences as in the Unicode standard's table 3-7 (no overlongs, surrogates or
-    // code points past U+10FFFF): the lead byte fixes the length and the second byte's range.
-    const unsigned char c = p[i];
-    size_t len = 0;
-    unsigned char lo = 0x80, hi = 0xBF;
-    if (c < 0x80) len = 1;
-    else if (c >= 0xC2 && c <= 0xDF) len = 2;
-    else if (c >= 0xE0 && c <= 0xEF) len = 3, lo = c == 0xE0 ? 0xA0 : 0x80, hi = c == 0xED ? 0x9F : 0xBF;
-    else if (c >= 0xF0 && c <= 0xF4) len = 4, lo = c == 0xF0 ? 0x90 : 0x80, hi = c == 0xF4 ? 0x8F : 0xBF;
-    bool ok = len > 0 && i + len <= n;
-    for (size_t k = 1; ok && k < len; ++k) ok = k == 1 ? p[i + k] >= lo && p[i + k] <= hi : (p[i + k] & 0xC0) == 0x80;
-    if (ok) {
-      out.append(s.data() + i, len);
-      i += len;
-    } else {
-      out += "\xEF\xBF\xBD";  // U+FFFD
-      ++i;
-    }
-  }
-  return out;
+  // Cut at a character boundary, then every ill-formed byte replaced (request_policy.h).
+  return to_valid_utf8(clip_utf8(std::string(s.substr(0, std::min(s.size(), max_bytes + 1))), max_bytes));
 }
 
 const std::string* RedisReply::field(const std::string& name) const {

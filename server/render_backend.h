@@ -55,11 +55,9 @@ class RenderBackend {
 
 // The embedded backend: renders in this process with `threads` threads.
 std::unique_ptr<RenderBackend> make_embedded_backend(SceneLibrary& scenes, int threads);
-// The Redis backend: `url` is redis://host:port. Throws when Redis cannot be reached.
-std::unique_ptr<RenderBackend> make_redis_backend(SceneLibrary& scenes, const std::string& url, int units_in_flight);
-// How long the Redis backend's jobs wait for an unreachable Redis before failing (--redis-timeout;
-// default 300 s). A process-wide setting, so that the job manager's construction of the backend
-// stays as it is.
-void set_redis_timeout(double seconds);
+// The Redis backend: `url` is redis://host:port. Throws when Redis cannot be reached at start; a
+// job waits out an unreachable Redis (a restart) for up to `redis_timeout` seconds, then fails.
+std::unique_ptr<RenderBackend> make_redis_backend(SceneLibrary& scenes, const std::string& url, int units_in_flight,
+                                                  double redis_timeout);
 
 }  // namespace srv
