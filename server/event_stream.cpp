@@ -66,7 +66,7 @@ std::vector<uint8_t> copy_display(const Job& job, int x, int y, int w, int h) {
 // A region's encoding younger than this is sent to watchers as it is, though the region has changed
 // since: watchers that wake at different moments share one encoding instead of each asking for the
 // newest version. The changes reach them in a later round; a job's last round is always exact.
-constexpr double kRegionRefreshSeconds = 0.1;
+constexpr double kRegionRefreshSeconds = 0.25;
 
 // The tile events for the regions of `job` newer than `sent` (which is brought up to date), each
 // region encoded once for every watcher. The job's mutex is held only to copy pixels. `exact`:
@@ -126,6 +126,10 @@ struct Snapshot {
   int width = 0, height = 0;
   uint64_t version = 0;  // the job version the picture shows
 };
+
+// What all event streams together send a second, at most (about: a round is sent whole, then the
+// watcher pauses for its share).
+constexpr double kStreamBytesPerSecond = 16e6;
 
 // A long pass still refreshes the whole-image PNG, at most this often.
 constexpr double kImageRefreshSeconds = 1.0;
@@ -232,9 +236,17 @@ void run_stream(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::Data
       return;
     }
     // After a round that sent tiles, let more accumulate, but wake at once for a change of state.
+    // The pause grows with what the round sent times the watchers sharing the budget: however
+    // many watch, and whatever tile size the job has, streams send about kStreamBytesPerSecond
+    // in all (sending, on loopback also receiving, is what watching costs the render).
     if (tiles.empty()) continue;
+    size_t bytes = 0;
+    for (const auto& event : tiles) bytes += event->size();
+    auto pause = std::max<Clock::duration>(
+        round_gap, std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                       double(bytes) * double(std::max<uint64_t>(1, g_watchers.load())) / kStreamBytesPerSecond)));
     std::unique_lock<std::mutex> lock(job->mutex);
-    job->changed.wait_for(lock, round_gap, [&] {
+    job->changed.wait_for(lock, pause, [&] {
       return last_state != job_state_name(job->state) || is_final(job->state) || jobs.stopping();
     });
   }
