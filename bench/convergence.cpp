@@ -125,7 +125,7 @@ int bench_main(int argc, char** argv) {
   std::vector<std::string> summary;
   // The estimate against the truth (relMSE less the reference's own noise), as the issue's
   // factor 1.5: min(est/true, true/est) >= 1/1.5 on every pass from 16 spp (the first passes
-  // read high with the Sobol sampler: docs/performance.md, nineteenth session).
+  // read high with the Sobol sampler: docs/performance.md, "Error estimate").
   TargetCheck within_1p5("the estimate within 1.5x of the true error from 16 spp, min(est/true, true/est) >= 0.67",
                          0.67, smoke);
   for (const BenchScene& sc : scenes) {

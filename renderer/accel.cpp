@@ -308,7 +308,7 @@ inline void to_embree(const Ray& r, RTCRay& e) {
 // The hit record from Embree's answer (accel_math.h). `eng()` gives Embree's unnormalised
 // geometric normal, read only for a degenerate triangle. Inlined into the packet loop: as a call,
 // its eight arguments and prologue cost 1.2% of CBbunny's instructions (docs/performance.md,
-// ninth session).
+// "Design choices that pay").
 template <class EmbreeNormal>
 [[gnu::always_inline]] inline void refine_hit(const GeomInfo& g, const Ray& ray, unsigned prim, float t, float u,
                                               float v, EmbreeNormal&& eng, SurfaceHit& hit) {

@@ -259,7 +259,7 @@ static_assert(offsetof(SurfaceHit, ng) == offsetof(SurfaceHit, p) + 12 &&
 #endif
 
 // refine_triangle_scalar's record with SSE: its bits, in about half the instructions (the hit
-// loop's refinement was a tenth of a mesh scene's pass; docs/performance.md, tenth session).
+// loop's refinement was a tenth of a mesh scene's pass; docs/performance.md, "Design choices that pay").
 template <class EmbreeNormal>
 [[gnu::always_inline]] inline void refine_triangle(const TriangleData& m, unsigned prim, float t, float u, float v,
                                                    EmbreeNormal&& eng, SurfaceHit& hit) {

@@ -455,7 +455,7 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
   // variance it also sees the faster convergence of stratified (Sobol) samples, each half of
   // which is itself well stratified.
   // mu stands for the pixel's true mean, which the true relMSE divides by. The pixel's own mean is
-  // a poor stand-in both ways (docs/performance.md, nineteenth session):
+  // a poor stand-in both ways (docs/performance.md, "Error estimate"):
   // - above its neighbourhood, a mean lifted by one half's rare bright sample divides its own
   //   error away (CBspheres at m = 100 fell to 0.6 of the truth): mu is at most the larger of the
   //   neighbourhood's median and the smaller half's mean;

@@ -4,7 +4,7 @@
 // The dashed guide: the relative MSE of an unbiased Monte Carlo estimate falls as 1/time (slope -1
 // on log-log axes; its square root, the RMSE, would fall as 1/sqrt(time)). It runs through the
 // latest point, where the ETA towards a target error extrapolates from (server/jobs.cpp), since
-// the first passes' estimates run high (docs/performance.md, eighteenth session).
+// the first passes' estimates run high (docs/performance.md, "Error estimate").
 function errorGuide(points) {
   const last = points[points.length - 1];
   return { slope: -1, seconds: last.seconds, error: last.error };
