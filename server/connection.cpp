@@ -160,13 +160,14 @@ class GuardedStream final : public httplib::Stream {
 
 thread_local GuardedStream* t_stream = nullptr;
 thread_local bool t_close = false;
+thread_local bool t_on_accept_thread = false;  // BoundedThreadPool ran this connection inline
 
 // Sends our FIN, then reads and discards what the client still sends (briefly, boundedly) before
 // closing: closing with unread bytes would reset the connection and could destroy the answer
 // before the client reads it.
-void linger_close(socket_t sock, const std::atomic<socket_t>& svr_sock) {
+void linger_close(socket_t sock, const std::atomic<socket_t>& svr_sock, double seconds = 1.0) {
   ::shutdown(sock, SHUT_WR);
-  auto until = after(1.0);
+  auto until = after(seconds);
   char scratch[16384];
   size_t drained = 0;
   while (drained < (size_t(1) << 20) && wait_ready(sock, POLLIN, until, svr_sock) == 1) {
@@ -199,7 +200,7 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
                        "Connection: close\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n";
     std::string all = head + body;
     ::send(sock, all.data(), all.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
-    linger_close(sock, svr_sock_);
+    linger_close(sock, svr_sock_, t_on_accept_thread ? 0.02 : 1.0);  // never stall the accepting thread
     return false;
   }
   double write_timeout = double(write_timeout_sec_) + double(write_timeout_usec_) / 1e6;
@@ -231,6 +232,51 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
     ::close(sock);
   }
   return ret;
+}
+
+BoundedThreadPool::BoundedThreadPool(size_t threads, size_t max_pending) : m_max_pending(max_pending) {
+  for (size_t i = 0; i < threads; ++i) m_threads.emplace_back([this] { work(); });
+}
+
+BoundedThreadPool::~BoundedThreadPool() { shutdown(); }
+
+void BoundedThreadPool::enqueue(std::function<void()> fn) {
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    if (m_jobs.size() < m_max_pending) {
+      m_jobs.push_back(std::move(fn));
+      m_cv.notify_one();
+      return;
+    }
+  }
+  t_on_accept_thread = true;
+  fn();
+  t_on_accept_thread = false;
+}
+
+void BoundedThreadPool::shutdown() {
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    if (m_shutdown) return;
+    m_shutdown = true;
+  }
+  m_cv.notify_all();
+  for (auto& t : m_threads)
+    if (t.joinable()) t.join();
+}
+
+void BoundedThreadPool::work() {
+  for (;;) {
+    std::function<void()> fn;
+    {
+      std::unique_lock<std::mutex> lock(m_mutex);
+      m_cv.wait(lock, [&] { return m_shutdown || !m_jobs.empty(); });
+      if (m_jobs.empty()) return;  // shut down, nothing left
+      fn = std::move(m_jobs.front());
+      m_jobs.pop_front();
+    }
+    fn();
+  }
 }
 
 bool ends_connection(int status) {

@@ -7,7 +7,13 @@
 #include <httplib.h>
 
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
 
 namespace srv {
 
@@ -33,6 +39,29 @@ class GuardedServer : public httplib::Server {
 
   ConnectionLimits m_limits;
   std::atomic<int> m_open{0};
+};
+
+// httplib's thread pool with a bound on accepted connections waiting for a thread: each holds a file
+// descriptor, and a flood queued without bound used them all up (a finished render then could not
+// write its image). Past the bound a connection is served on the accepting thread itself, which
+// answers it 503 at once (all threads being busy means the connection cap is reached); meanwhile
+// new connections wait in the kernel's backlog, where they cost this process no descriptor.
+class BoundedThreadPool : public httplib::TaskQueue {
+ public:
+  BoundedThreadPool(size_t threads, size_t max_pending);
+  ~BoundedThreadPool() override;
+  void enqueue(std::function<void()> fn) override;
+  void shutdown() override;
+
+ private:
+  void work();
+
+  size_t m_max_pending;
+  std::mutex m_mutex;
+  std::condition_variable m_cv;
+  std::deque<std::function<void()>> m_jobs;
+  std::vector<std::thread> m_threads;
+  bool m_shutdown = false;
 };
 
 // Why reading the current thread's request failed, for the error handler to answer 408 or 431

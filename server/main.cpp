@@ -62,6 +62,11 @@ bool parse_int(const char* s, long lo, long hi, long* out) {
   return true;
 }
 
+// Threads beyond the connection cap (those over it are answered 503 by a thread), and accepted
+// connections that may wait for a thread.
+constexpr long kExtraThreads = 16;
+constexpr size_t kMaxPendingConnections = 16;
+
 // Raises the soft descriptor limit to the hard one, and keeps the connection cap below it with room
 // for the files, scenes and images jobs open: a connection flood must never leave a finished render
 // unable to write its image.
@@ -73,10 +78,13 @@ int connection_cap(int wanted, int threads) {
     raised.rlim_cur = lim.rlim_max == RLIM_INFINITY ? std::max<rlim_t>(lim.rlim_cur, 1 << 16) : lim.rlim_max;
     if (setrlimit(RLIMIT_NOFILE, &raised) == 0) lim = raised;
   }
-  long reserve = 64 + 4L * threads;  // job files, scene reads, image writes, Embree/TBB, logs
-  long room = lim.rlim_cur == RLIM_INFINITY ? wanted : long(lim.rlim_cur) - reserve;
-  if (room >= wanted) return wanted;
-  int cap = int(std::max(1L, room / 2));  // an accepted socket and, briefly, what serving it opens
+  // Descriptors in use at most: the reserve (job files, scene reads, image writes, logs), two per
+  // connection being served (its socket and a file it may read), and the accepted connections
+  // waiting for a thread (BoundedThreadPool) plus one on the accepting thread.
+  long reserve = 64 + 4L * threads + kMaxPendingConnections + 1;
+  long room = lim.rlim_cur == RLIM_INFINITY ? 2L * (wanted + kExtraThreads) : long(lim.rlim_cur) - reserve;
+  if (room >= 2L * (wanted + kExtraThreads)) return wanted;
+  int cap = int(std::max(1L, room / 2 - kExtraThreads));
   std::fprintf(stderr, "render-server: --max-connections %d lowered to %d: the descriptor limit is %llu\n", wanted, cap,
                (unsigned long long)lim.rlim_cur);
   return cap;
@@ -166,8 +174,8 @@ int main(int argc, char** argv) {
   // One thread per open connection (event streams hold theirs): the pool outnumbers the connection
   // cap, so connections over it are answered 503 at once instead of queueing.
   srv::GuardedServer svr(api.limits);
-  int pool = api.limits.max_connections + 16;
-  svr.new_task_queue = [pool] { return new httplib::ThreadPool(size_t(pool)); };
+  int pool = api.limits.max_connections + kExtraThreads;
+  svr.new_task_queue = [pool] { return new srv::BoundedThreadPool(size_t(pool), kMaxPendingConnections); };
   svr.set_write_timeout(10, 0);
   svr.set_keep_alive_max_count(100);
   svr.set_keep_alive_timeout(1);  // an idle connection holds up a shutdown this long at most
