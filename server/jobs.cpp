@@ -127,7 +127,10 @@ void JobManager::stop() {
   m_queue_cv.notify_all();
   {
     std::lock_guard<std::mutex> lock(m_mutex);
-    for (auto& kv : m_jobs) kv.second->changed.notify_all();
+    for (auto& kv : m_jobs) {
+      kv.second->halt = true;  // a running render stops; run_job puts it back in the queue
+      kv.second->changed.notify_all();
+    }
   }
   for (auto& w : m_workers)
     if (w.joinable()) w.join();
@@ -215,6 +218,7 @@ void JobManager::cancel(const std::string& id) {
   if (is_final(job->state))
     throw ApiError(409, std::string("job is already ") + job_state_name(job->state));
   job->cancel = true;  // the worker stops within a few samples and marks it cancelled
+  job->halt = true;
 }
 
 json JobManager::status_json(const Job& j, bool with_history) const {
@@ -376,29 +380,11 @@ void JobManager::worker_loop() {
 void JobManager::run_job(const std::shared_ptr<Job>& job) {
   auto notify = [&] { job->changed.notify_all(); };
   try {
-    // One flag stops the render: user cancel or shutdown (polled every 20 ms). The time limit and
-    // the error target are the backend's.
-    std::atomic<bool> stop{false}, done{false};
-    std::thread poller([&] {
-      while (!done) {
-        if (job->cancel || m_stopping) {
-          stop = true;
-          return;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      }
-    });
-    struct Joiner {
-      std::atomic<bool>& done;
-      std::thread& t;
-      ~Joiner() {
-        done = true;
-        if (t.joinable()) t.join();
-      }
-    } joiner{done, poller};
-
+    // One flag stops the render: a user's cancel or the server's shutdown set it directly (the
+    // time limit and the error target are the backend's).
+    job->halt = job->cancel || m_stopping;
     JobStateSink sink(*job, [this](Job& j) { persist(j); });
-    RenderResult result = m_backend->render(*job, sink, stop);
+    RenderResult result = m_backend->render(*job, sink, job->halt);
 
     if (m_stopping && !job->cancel) {  // shutdown: run it again after a restart
       std::lock_guard<std::mutex> lock(job->mutex);

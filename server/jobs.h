@@ -39,6 +39,7 @@ struct Job {
   JobSpec spec;
   std::string idempotency_key;
   std::atomic<bool> cancel{false};
+  std::atomic<bool> halt{false};  // stops its render: set by a cancel or the server's shutdown
 
   mutable std::mutex mutex;
   std::condition_variable changed;

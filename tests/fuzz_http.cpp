@@ -48,10 +48,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string type = srv::media_type(content_type);
   require(type.empty() || type.find('/') != std::string::npos);
   std::string h, p;
-  if (srv::split_host(host, h, p)) require(!h.empty() && p.size() <= 5);
+  bool well_formed = srv::split_host(host, h, p);
+  if (well_formed) require(!h.empty() && p.size() <= 5);
   srv::HostPolicy loopback, open;
   open.loopback_only = false;
-  require(open.allows(host));  // a server bound to the network with no --allowed-host answers all
+  // A server bound to the network with no --allowed-host answers every well-formed Host (and a
+  // request without one); a malformed one is refused everywhere.
+  require(open.allows(host) == (host.empty() || well_formed));
   if (loopback.allows(host) && !host.empty()) require(srv::is_loopback_host(h));
   (void)srv::cross_site_request(origin, fetch_site, host);
   require(srv::count_ranges(range) >= 0);
