@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <mutex>
+#include <vector>
 
 #include "image.h"
 
@@ -16,6 +18,40 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 std::atomic<uint64_t> g_watchers{0}, g_png_encodes{0}, g_tile_events{0};
+
+// A job's PNG encodings, shared by every client: each region version, and the whole image once a
+// pass, is encoded once however many ask. `mutex` is never held by the render threads; it is taken
+// before the job's mutex when both are needed.
+struct Encodings {
+  std::mutex mutex;
+  std::vector<std::shared_ptr<const std::string>> region_event;  // a region's SSE tile event, less its id
+  std::vector<uint64_t> region_event_version;
+  std::vector<double> region_event_time;  // steady seconds when each was encoded
+  std::string image_png;                  // the whole display image
+  int image_png_width = 0, image_png_height = 0;
+  uint64_t image_png_pass = ~uint64_t(0), image_png_version = 0;
+  double image_png_time = 0;  // steady seconds when it was encoded
+};
+
+// The encodings of the jobs clients asked for most recently; a job's stay while a stream or a
+// request holds them, and until kCachedJobs others are asked for after it.
+constexpr size_t kCachedJobs = 32;
+std::mutex g_cache_mutex;
+std::vector<std::pair<std::string, std::shared_ptr<Encodings>>> g_cache;  // most recent last
+
+std::shared_ptr<Encodings> encodings_for(const Job& job) {
+  std::lock_guard<std::mutex> lock(g_cache_mutex);
+  for (size_t i = 0; i < g_cache.size(); ++i)
+    if (g_cache[i].first == job.id) {
+      auto hit = g_cache[i];
+      g_cache.erase(g_cache.begin() + long(i));
+      g_cache.push_back(hit);
+      return hit.second;
+    }
+  if (g_cache.size() >= kCachedJobs) g_cache.erase(g_cache.begin());
+  g_cache.push_back({job.id, std::make_shared<Encodings>()});
+  return g_cache.back().second;
+}
 
 std::string encode_png(const std::vector<uint8_t>& rgb, int w, int h) {
   ++g_png_encodes;
@@ -71,7 +107,8 @@ constexpr double kRegionRefreshSeconds = 0.25;
 // The tile events for the regions of `job` newer than `sent` (which is brought up to date), each
 // region encoded once for every watcher. The job's mutex is held only to copy pixels. `exact`:
 // every region at its current version (the stream's last round).
-std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, std::vector<uint64_t>& sent, bool exact) {
+std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, Encodings& enc, std::vector<uint64_t>& sent,
+                                                                bool exact) {
   struct Stale {
     size_t index;
     uint64_t version;
@@ -80,21 +117,21 @@ std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, std::v
   };
   std::vector<std::pair<size_t, uint64_t>> changed;
   std::vector<Stale> stale;
-  std::lock_guard<std::mutex> encoding(job.encode_mutex);
+  std::lock_guard<std::mutex> encoding(enc.mutex);
   {
     std::lock_guard<std::mutex> lock(job.mutex);
     size_t n = job.region_version.size();
-    if (job.region_event.size() != n) {
-      job.region_event.assign(n, nullptr);
-      job.region_event_version.assign(n, 0);
-      job.region_event_time.assign(n, 0.0);
+    if (enc.region_event.size() != n) {
+      enc.region_event.assign(n, nullptr);
+      enc.region_event_version.assign(n, 0);
+      enc.region_event_time.assign(n, 0.0);
     }
     if (sent.size() != n) sent.assign(n, 0);
     double now = steady_seconds();
     for (size_t i = 0; i < n; ++i) {
-      uint64_t v = job.region_version[i], cached = job.region_event_version[i];
+      uint64_t v = job.region_version[i], cached = enc.region_event_version[i];
       if (v <= sent[i]) continue;
-      if (cached == v || (!exact && cached > sent[i] && now - job.region_event_time[i] < kRegionRefreshSeconds)) {
+      if (cached == v || (!exact && cached > sent[i] && now - enc.region_event_time[i] < kRegionRefreshSeconds)) {
         changed.push_back({i, cached});
         continue;
       }
@@ -108,14 +145,14 @@ std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, std::v
     char head[128];
     std::snprintf(head, sizeof head, "event: tile\ndata: {\"x\":%d,\"y\":%d,\"w\":%d,\"h\":%d,\"png\":\"", s.x, s.y, s.w,
                   s.h);
-    job.region_event[s.index] =
+    enc.region_event[s.index] =
         std::make_shared<const std::string>(head + base64(encode_png(s.rgb, s.w, s.h)) + "\"}\n\n");
-    job.region_event_version[s.index] = s.version;
-    job.region_event_time[s.index] = steady_seconds();
+    enc.region_event_version[s.index] = s.version;
+    enc.region_event_time[s.index] = steady_seconds();
   }
   std::vector<std::shared_ptr<const std::string>> events;
   for (auto [i, v] : changed) {
-    events.push_back(job.region_event[i]);
+    events.push_back(enc.region_event[i]);
     sent[i] = v;
   }
   return events;
@@ -135,17 +172,19 @@ constexpr double kStreamBytesPerSecond = 16e6;
 constexpr double kImageRefreshSeconds = 1.0;
 
 Snapshot snapshot_png(Job& job) {
-  std::lock_guard<std::mutex> encoding(job.encode_mutex);
+  std::shared_ptr<Encodings> held = encodings_for(job);
+  Encodings& enc = *held;
+  std::lock_guard<std::mutex> encoding(enc.mutex);
   std::vector<uint8_t> rgb;
   Snapshot s;
   uint64_t pass;
   {
     std::lock_guard<std::mutex> lock(job.mutex);
     if (!job.has_image) return s;
-    bool same_pass = job.image_png_pass == job.passes;
-    if (job.image_png_version == job.version ||
-        (same_pass && steady_seconds() - job.image_png_time < kImageRefreshSeconds))
-      return {job.image_png, job.image_png_width, job.image_png_height, job.image_png_version};
+    bool same_pass = enc.image_png_pass == job.passes;
+    if (enc.image_png_version == job.version ||
+        (same_pass && steady_seconds() - enc.image_png_time < kImageRefreshSeconds))
+      return {enc.image_png, enc.image_png_width, enc.image_png_height, enc.image_png_version};
     rgb = copy_display(job, 0, 0, job.width, job.height);
     s.width = job.width;
     s.height = job.height;
@@ -153,16 +192,17 @@ Snapshot snapshot_png(Job& job) {
     pass = job.passes;
   }
   s.png = encode_png(rgb, s.width, s.height);  // outside the mutex the render threads take
-  job.image_png = s.png;
-  job.image_png_width = s.width;
-  job.image_png_height = s.height;
-  job.image_png_pass = pass;
-  job.image_png_version = s.version;
-  job.image_png_time = steady_seconds();
+  enc.image_png = s.png;
+  enc.image_png_width = s.width;
+  enc.image_png_height = s.height;
+  enc.image_png_pass = pass;
+  enc.image_png_version = s.version;
+  enc.image_png_time = steady_seconds();
   return s;
 }
 
 void run_stream(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::DataSink& sink) {
+  const std::shared_ptr<Encodings> encodings = encodings_for(*job);  // held for the stream's life
   std::vector<uint64_t> sent;
   uint64_t seen = 0;
   bool first = true;
@@ -225,7 +265,7 @@ void run_stream(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::Data
     if (!status.is_null() && !write(sse("status", status, version))) return;
     // The id is this round's version, not the region's: ids never go back within a stream.
     const std::string id = "id: " + std::to_string(version) + "\n";
-    std::vector<std::shared_ptr<const std::string>> tiles = changed_regions(*job, sent, final_state);
+    std::vector<std::shared_ptr<const std::string>> tiles = changed_regions(*job, *encodings, sent, final_state);
     for (const auto& event : tiles) {
       if (!write(id) || !write(*event)) return;
       ++g_tile_events;

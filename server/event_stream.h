@@ -1,6 +1,7 @@
 // A job's image as clients see it while it renders: the Server-Sent Events stream (the whole image,
 // then changed regions and status) and the whole-image PNG of a running job. Every encoding is made
-// once and shared by all clients (the job's encode cache), outside the mutex the render threads take.
+// once and shared by all clients (a cache of the recently watched jobs), outside the mutex the render
+// threads take.
 #pragma once
 
 #include <httplib.h>

@@ -10,20 +10,6 @@ namespace srv {
 
 namespace {
 
-// The methods each API path answers (keep in step with install_routes): a known path asked with
-// another method gets 405 and an Allow header instead of 404.
-std::string allowed_methods(const std::string& path) {
-  static const std::pair<std::regex, const char*> table[] = {
-      {std::regex("/api/(health|openapi\\.json|scenes)"), "GET"},
-      {std::regex("/api/jobs"), "GET, POST"},
-      {std::regex("/api/jobs/check"), "POST"},
-      {std::regex("/api/jobs/[^/]+"), "GET, DELETE"},
-      {std::regex("/api/jobs/[^/]+/(image\\.png|image\\.exr|focus|events)"), "GET"}};
-  for (const auto& [re, allow] : table)
-    if (std::regex_match(path, re)) return allow;
-  return "";
-}
-
 // ---- access token ----
 
 const char* const kNoToken = "this server requires a token: send 'Authorization: Bearer <token>'";
@@ -82,15 +68,33 @@ void send_error(httplib::Response& res, int status, const std::string& message, 
   send_json(res, status, json{{"error", err}});
 }
 
+int http_status(JobErrorKind kind) {
+  switch (kind) {
+    case JobErrorKind::invalid: return 400;
+    case JobErrorKind::not_found: return 404;
+    case JobErrorKind::conflict: return 409;
+    case JobErrorKind::queue_full: return 429;
+    case JobErrorKind::shutting_down: return 503;
+    case JobErrorKind::no_storage: return 507;
+    case JobErrorKind::scene_broken: return 422;
+  }
+  return 500;
+}
+
+void send_error_status(httplib::Response& res, int status, const std::string& message, const std::string& field) {
+  send_error(res, status, message, field);
+  if (status == 429 || status == 503) res.set_header("Retry-After", "5");
+}
+
 json parse_body(const httplib::Request& req) {
   std::string type = media_type(req.get_header_value("Content-Type"));
   if (type != "application/json")
-    throw ApiError(415, "Content-Type must be application/json (got '" +
+    throw HttpError(415, "Content-Type must be application/json (got '" +
                             to_valid_utf8(clip_utf8(req.get_header_value("Content-Type"), 100)) + "')");
   try {
     return json::parse(req.body);
   } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e400
-    throw ApiError(400, std::string("malformed JSON: ") + e.what());
+    throw HttpError(400, std::string("malformed JSON: ") + e.what());
   }
 }
 
@@ -186,7 +190,8 @@ void install_guards(httplib::Server& svr, const ApiOptions& options) {
     return res.status;
   });
 
-  svr.set_error_handler([limits = options.limits, max_body = options.max_body](const httplib::Request& req,
+  svr.set_error_handler([limits = options.limits, max_body = options.max_body,
+                         allowed_methods = options.allowed_methods](const httplib::Request& req,
                                                                               httplib::Response& res) {
     // httplib answers 400 (413 for a Content-Length over the limit) when reading a request fails:
     // say why where the connection layer knows.
@@ -203,7 +208,7 @@ void install_guards(httplib::Server& svr, const ApiOptions& options) {
     // httplib answers a well-formed request with a method it does not serve (TRACE, QUERY, ...)
     // 400: it is 405, with the methods that are.
     if (res.status == 400 && failure == ReadFailure::none && well_formed_unknown_method(req)) {
-      std::string allow = allowed_methods(req.path);
+      std::string allow = allowed_methods ? allowed_methods(req.path) : "";
       res.set_header("Allow", allow.empty() ? "GET, HEAD" : allow);
       send_error(res, 405, req.method + " is not allowed here (allowed: " + (allow.empty() ? "GET, HEAD" : allow) + ")");
       close_after_response();  // httplib read no body for it: none may be parsed as the next request
@@ -211,7 +216,7 @@ void install_guards(httplib::Server& svr, const ApiOptions& options) {
     }
     if (ends_connection(res.status)) res.set_header("Connection", "close");
     if (!res.body.empty()) return;  // a handler already wrote its JSON error
-    std::string allow = res.status == 404 ? allowed_methods(req.path) : "";
+    std::string allow = res.status == 404 && allowed_methods ? allowed_methods(req.path) : "";
     if (!allow.empty()) {
       res.set_header("Allow", allow);
       return send_error(res, 405, req.method + " is not allowed on " + req.path + " (allowed: " + allow + ")");

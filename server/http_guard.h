@@ -5,6 +5,7 @@
 
 #include <httplib.h>
 
+#include <functional>
 #include <string>
 
 #include "connection.h"
@@ -19,6 +20,9 @@ struct ApiOptions {
   ConnectionLimits limits;  // named in the 408 / 431 messages
   size_t max_body = 64 * 1024;  // request body bytes (413 beyond)
   HostPolicy hosts;         // which Host headers are answered (421 otherwise)
+  // The methods a path answers ("" for none): a known path asked with another method gets 405 and
+  // this in its Allow header. install_routes sets it from its route table.
+  std::function<std::string(const std::string&)> allowed_methods;
 };
 
 void send_json(httplib::Response& res, int status, const json& body);
@@ -29,19 +33,39 @@ void send_error(httplib::Response& res, int status, const std::string& message, 
 // must parse (400).
 json parse_body(const httplib::Request& req);
 
-// Runs a handler body, turning ApiError into its JSON error and any other exception into a 500:
-// nothing thrown leaves a handler.
+// An error only the HTTP layer raises (a header, a query parameter, the body), with its status.
+class HttpError : public std::runtime_error {
+ public:
+  HttpError(int status, std::string message, std::string field = "")
+      : std::runtime_error(std::move(message)), m_status(status), m_field(std::move(field)) {}
+  int status() const { return m_status; }
+  const std::string& field() const { return m_field; }
+
+ private:
+  int m_status;
+  std::string m_field;
+};
+
+// The HTTP status that answers each kind of job-service error.
+int http_status(JobErrorKind kind);
+
+// Answers an error with its JSON body (and Retry-After where retrying later helps).
+void send_error_status(httplib::Response& res, int status, const std::string& message, const std::string& field);
+
+// Runs a handler body, turning HttpError and JobError into their JSON errors and any other
+// exception into a 500 (503 when memory ran out): nothing thrown leaves a handler.
 template <typename F>
 void guarded(httplib::Response& res, F&& f) {
   try {
     f();
-  } catch (const ApiError& e) {
-    send_error(res, e.status(), e.what(), e.field());
-    if (e.status() == 429 || e.status() == 503) res.set_header("Retry-After", "5");
+  } catch (const HttpError& e) {
+    send_error_status(res, e.status(), e.what(), e.field());
+  } catch (const JobError& e) {
+    send_error_status(res, http_status(e.kind()), e.what(), e.field());
   } catch (const std::bad_alloc&) {
     send_error(res, 503, "the server is out of memory for this request; retry later");
   } catch (const std::exception& e) {
-    send_error(res, 500, e.what());
+    send_error(res, 500, to_valid_utf8(e.what()));
   }
 }
 

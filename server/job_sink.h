@@ -23,7 +23,7 @@ class JobStateSink : public JobSink {
     Job& j = m_job;
     {
       std::lock_guard<std::mutex> lock(j.mutex);
-      if (j.cancel) throw ApiError(409, "cancelled");
+      if (j.cancel) throw JobError(JobErrorKind::conflict, "cancelled");
       j.state = JobState::running;
       j.started_at = now_unix_seconds();
       j.width = width;

@@ -22,31 +22,31 @@ struct Reader {
     const json* v = get(field);
     if (!v) return def;
     if (!v->is_number_integer() && !v->is_number_unsigned())
-      throw ApiError(400, std::string("'") + field + "' must be an integer", field);
+      throw JobError(JobErrorKind::invalid, std::string("'") + field + "' must be an integer", field);
     if (v->is_number_unsigned() && v->get<unsigned long long>() > (unsigned long long)hi)
-      throw ApiError(400, std::string("'") + field + "' must be at most " + std::to_string(hi), field);
+      throw JobError(JobErrorKind::invalid, std::string("'") + field + "' must be at most " + std::to_string(hi), field);
     long long x = v->get<long long>();
     if (x < lo || x > hi)
-      throw ApiError(400, std::string("'") + field + "' must be between " + std::to_string(lo) + " and " + std::to_string(hi), field);
+      throw JobError(JobErrorKind::invalid, std::string("'") + field + "' must be between " + std::to_string(lo) + " and " + std::to_string(hi), field);
     return x;
   }
   double number(const char* field, double def, double lo, double hi) {
     const json* v = get(field);
     if (!v) return def;
-    if (!v->is_number()) throw ApiError(400, std::string("'") + field + "' must be a number", field);
+    if (!v->is_number()) throw JobError(JobErrorKind::invalid, std::string("'") + field + "' must be a number", field);
     double x = v->get<double>();
-    if (!std::isfinite(x)) throw ApiError(400, std::string("'") + field + "' must be finite", field);
+    if (!std::isfinite(x)) throw JobError(JobErrorKind::invalid, std::string("'") + field + "' must be finite", field);
     if (x < lo || x > hi) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "'%s' must be between %g and %g", field, lo, hi);
-      throw ApiError(400, buf, field);
+      throw JobError(JobErrorKind::invalid, buf, field);
     }
     return x;
   }
   bool boolean(const char* field, bool def) {
     const json* v = get(field);
     if (!v) return def;
-    if (!v->is_boolean()) throw ApiError(400, std::string("'") + field + "' must be true or false", field);
+    if (!v->is_boolean()) throw JobError(JobErrorKind::invalid, std::string("'") + field + "' must be true or false", field);
     return v->get<bool>();
   }
 };
@@ -62,16 +62,16 @@ bool valid_scene_name(const std::string& name) {
 }
 
 JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
-  if (!body.is_object()) throw ApiError(400, "the request body must be a JSON object");
+  if (!body.is_object()) throw JobError(JobErrorKind::invalid, "the request body must be a JSON object");
   Reader r{body, {}};
   JobSpec s;
   pt::RenderParams& p = s.params;
   const json* scene = r.get("scene");
-  if (!scene) throw ApiError(400, "'scene' is required", "scene");
-  if (!scene->is_string()) throw ApiError(400, "'scene' must be a string", "scene");
+  if (!scene) throw JobError(JobErrorKind::invalid, "'scene' is required", "scene");
+  if (!scene->is_string()) throw JobError(JobErrorKind::invalid, "'scene' must be a string", "scene");
   s.scene = scene->get<std::string>();
   if (!valid_scene_name(s.scene))
-    throw ApiError(400, "'scene' must be a scene name (letters, digits, '_', '-', '.'; no paths)", "scene");
+    throw JobError(JobErrorKind::invalid, "'scene' must be a scene name (letters, digits, '_', '-', '.'; no paths)", "scene");
   p.max_depth = int(r.integer("max_depth", 5, 0, lim.max_depth));
   p.lens_radius = float(r.number("aperture", 0, 0, 1000));
   p.focal_distance = float(r.number("focal_distance", 4.7, 0, 1e6));
@@ -91,18 +91,18 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   s.time_limit = r.number("time_limit", 0, 0, 7 * 86400);
   s.target_error = r.number("target_error", 0, 0, 1);
   for (auto it = body.begin(); it != body.end(); ++it)
-    if (!r.seen.count(it.key())) throw ApiError(400, "unknown field '" + it.key() + "'", it.key());
+    if (!r.seen.count(it.key())) throw JobError(JobErrorKind::invalid, "unknown field '" + it.key() + "'", it.key());
   double pixel_samples = double(p.width) * p.height * p.spp;
   if (pixel_samples > lim.max_pixel_samples) {
     char buf[200];
     std::snprintf(buf, sizeof buf, "width x height x spp = %.0f exceeds the limit of %.0f", pixel_samples,
                   lim.max_pixel_samples);
-    throw ApiError(400, buf, "spp");
+    throw JobError(JobErrorKind::invalid, buf, "spp");
   }
   try {
     p.validate();
   } catch (const std::invalid_argument& e) {
-    throw ApiError(400, e.what());
+    throw JobError(JobErrorKind::invalid, e.what());
   }
   return s;
 }

@@ -18,16 +18,27 @@ inline std::string dump_json(const json& j, int indent = -1) {
   return j.dump(indent, ' ', false, json::error_handler_t::replace);
 }
 
-// A request error: HTTP status, message and the offending field ("" when none).
-class ApiError : public std::runtime_error {
+// Why the job service refuses something, in its own terms (the HTTP layer maps each kind to a
+// status: http_guard.cpp). `field` names the offending field, header or parameter ("" when none).
+enum class JobErrorKind {
+  invalid,        // a field's value is not acceptable
+  not_found,      // no such job or scene
+  conflict,       // the job's state forbids it, or an idempotency key was reused
+  queue_full,     // too many jobs waiting: retry later
+  shutting_down,  // the server is stopping: retry later
+  no_storage,     // the data folder cannot store the job
+  scene_broken,   // the job's scene no longer loads
+};
+
+class JobError : public std::runtime_error {
  public:
-  ApiError(int status, std::string message, std::string field = "")
-      : std::runtime_error(std::move(message)), m_status(status), m_field(std::move(field)) {}
-  int status() const { return m_status; }
+  JobError(JobErrorKind kind, std::string message, std::string field = "")
+      : std::runtime_error(std::move(message)), m_kind(kind), m_field(std::move(field)) {}
+  JobErrorKind kind() const { return m_kind; }
   const std::string& field() const { return m_field; }
 
  private:
-  int m_status;
+  JobErrorKind m_kind;
   std::string m_field;
 };
 
@@ -43,7 +54,7 @@ struct SpecLimits {
   double max_pixel_samples = 4294967296.0;  // width * height * spp
 };
 
-// Parses a JSON body (already parsed) into a spec with defaults; throws ApiError(400, ..., field).
+// Parses a JSON body (already parsed) into a spec with defaults; throws JobError(invalid, ..., field).
 JobSpec parse_job_spec(const json& body, const SpecLimits& limits = {});
 json job_spec_to_json(const JobSpec& spec);
 // The defaults and limits, as the API documents them.

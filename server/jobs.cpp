@@ -139,25 +139,25 @@ void JobManager::stop() {
 JobSpec JobManager::check(const json& body) const {
   JobSpec spec = parse_job_spec(body, m_config.limits);
   if (m_scenes.resolve(spec.scene).empty())
-    throw ApiError(404, "unknown scene '" + spec.scene + "'", "scene");
+    throw JobError(JobErrorKind::not_found, "unknown scene '" + spec.scene + "'", "scene");
   return spec;
 }
 
 std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const std::string& key) {
   JobSpec spec = check(body);
   std::lock_guard<std::mutex> lock(m_mutex);
-  if (m_stopping) throw ApiError(503, "the server is shutting down");
+  if (m_stopping) throw JobError(JobErrorKind::shutting_down, "the server is shutting down");
   if (!key.empty()) {
     auto it = m_idempotency.find(key);
     if (it != m_idempotency.end()) {
       auto job = m_jobs.at(it->second);
       if (job_spec_to_json(job->spec) != job_spec_to_json(spec))
-        throw ApiError(409, "Idempotency-Key was used for a different job", "Idempotency-Key");
+        throw JobError(JobErrorKind::conflict, "Idempotency-Key was used for a different job", "Idempotency-Key");
       return {job, false};
     }
   }
   if (m_queue.size() >= m_config.max_queue)
-    throw ApiError(429, "the queue is full (" + std::to_string(m_config.max_queue) + " jobs waiting); retry later");
+    throw JobError(JobErrorKind::queue_full, "the queue is full (" + std::to_string(m_config.max_queue) + " jobs waiting); retry later");
   auto job = std::make_shared<Job>();
   job->id = new_job_id();
   job->spec = spec;
@@ -173,7 +173,7 @@ std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const
       std::fprintf(stderr, "render-server: job %s: %s\n", job->id.c_str(), e.what());
       rmdir(job_dir(job->id).c_str());
       std::string why = e.what();
-      throw ApiError(507, "the data directory cannot store the job (" + why.substr(why.rfind(": ") + 2) + ")");
+      throw JobError(JobErrorKind::no_storage, "the data directory cannot store the job (" + why.substr(why.rfind(": ") + 2) + ")");
     }
   }
   m_jobs[job->id] = job;
@@ -199,7 +199,7 @@ std::vector<std::shared_ptr<Job>> JobManager::list() const {
 
 void JobManager::cancel(const std::string& id) {
   auto job = get(id);
-  if (!job) throw ApiError(404, "no job '" + id + "'");
+  if (!job) throw JobError(JobErrorKind::not_found, "no job '" + id + "'");
   {
     std::lock_guard<std::mutex> lock(m_mutex);
     auto it = std::find(m_queue.begin(), m_queue.end(), job);
@@ -216,7 +216,7 @@ void JobManager::cancel(const std::string& id) {
   }
   std::lock_guard<std::mutex> jl(job->mutex);
   if (is_final(job->state))
-    throw ApiError(409, std::string("job is already ") + job_state_name(job->state));
+    throw JobError(JobErrorKind::conflict, std::string("job is already ") + job_state_name(job->state));
   job->cancel = true;  // the worker stops within a few samples and marks it cancelled
   job->halt = true;
 }
@@ -256,15 +256,15 @@ json JobManager::status_json(const Job& j, bool with_history) const {
 double JobManager::focus_distance(const Job& job, double x, double y) {
   pt::RenderParams p = job.spec.params;
   std::string size = std::to_string(p.width) + "x" + std::to_string(p.height);
-  if (!(x >= 0 && x <= p.width)) throw ApiError(400, "x must lie inside the " + size + " image", "x");
-  if (!(y >= 0 && y <= p.height)) throw ApiError(400, "y must lie inside the " + size + " image", "y");
+  if (!(x >= 0 && x <= p.width)) throw JobError(JobErrorKind::invalid, "x must lie inside the " + size + " image", "x");
+  if (!(y >= 0 && y <= p.height)) throw JobError(JobErrorKind::invalid, "y must lie inside the " + size + " image", "y");
   std::shared_ptr<const pt::SceneBase> base;
   try {
     base = m_scenes.load(job.spec.scene);
-  } catch (const ApiError& e) {  // the scene file is gone: the job is fine, its scene is not
-    throw ApiError(422, "the job's scene no longer loads: " + std::string(e.what()), "scene");
+  } catch (const JobError& e) {  // the scene file is gone: the job is fine, its scene is not
+    throw JobError(JobErrorKind::scene_broken, "the job's scene no longer loads: " + std::string(e.what()), "scene");
   } catch (const pt::SceneError& e) {
-    throw ApiError(422, "the job's scene no longer loads: " + to_valid_utf8(e.what()), "scene");
+    throw JobError(JobErrorKind::scene_broken, "the job's scene no longer loads: " + to_valid_utf8(e.what()), "scene");
   }
   p.env_map.clear();
   auto scene = pt::make_view(*base, p);

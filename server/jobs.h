@@ -61,18 +61,6 @@ struct Job {
   std::vector<uint64_t> region_version;  // the job version that last changed each region
   uint64_t passes = 0;                   // passes published so far (the whole-image PNG's cache key)
   bool has_image = false;
-
-  // PNG encodings shared by every client (event_stream.cpp): each region version, and the whole
-  // image once a pass, is encoded once however many ask. Guarded by encode_mutex, never held by the
-  // render threads; taken before `mutex` when both are needed.
-  std::mutex encode_mutex;
-  std::vector<std::shared_ptr<const std::string>> region_event;  // a region's SSE tile event, less its id
-  std::vector<uint64_t> region_event_version;
-  std::vector<double> region_event_time;  // steady seconds when each was encoded
-  std::string image_png;  // the whole display image
-  int image_png_width = 0, image_png_height = 0;
-  uint64_t image_png_pass = ~uint64_t(0), image_png_version = 0;
-  double image_png_time = 0;  // steady seconds when it was encoded
 };
 
 struct ManagerConfig {
@@ -104,7 +92,7 @@ class JobManager {
   JobSpec check(const json& body) const;
   std::shared_ptr<Job> get(const std::string& id) const;
   std::vector<std::shared_ptr<Job>> list() const;
-  // Cancels a queued or running job; throws ApiError 409 for a finished one.
+  // Cancels a queued or running job; throws JobError(conflict) for a finished one.
   void cancel(const std::string& id);
 
   json status_json(const Job& job, bool with_history = true) const;  // job.mutex must be held

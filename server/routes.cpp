@@ -1,149 +1,214 @@
-// HTTP routes: thin handlers that validate, enqueue or copy a status snapshot. What every request
-// passes first is http_guard.cpp; the event stream and shared image encodings, event_stream.cpp.
+// HTTP routes: one table of (method, path, handler), grouped by resource, from which both the
+// registration with httplib and the Allow header of a 405 are made. Handlers are thin: they
+// validate, call the job service, or copy a status snapshot. What every request passes first is
+// http_guard.cpp; the event stream and the shared image encodings, event_stream.cpp.
 #include "routes.h"
 
 #include <cmath>
 #include <cstring>
+#include <regex>
 
 #include "event_stream.h"
 #include "image.h"
 
 namespace srv {
 
-void install_routes(httplib::Server& svr, JobManager& jobs, const ApiOptions& options) {
-  const std::string openapi = options.openapi;
-  install_guards(svr, options);
+namespace {
 
-  svr.Get("/api/health", [&](const httplib::Request&, httplib::Response& res) {
-    size_t queued = 0, running = 0;
-    for (auto& j : jobs.list()) {
-      std::lock_guard<std::mutex> lock(j->mutex);
-      queued += j->state == JobState::queued;
-      running += j->state == JobState::running;
-    }
-    json health{{"status", "ok"}, {"queued", queued}, {"running", running}, {"rendering", jobs.backend_name()}};
-    StreamStats st = stream_stats();
-    health["stream"] = {{"watchers", st.watchers}, {"png_encodes", st.png_encodes}, {"tile_events", st.tile_events}};
-    int workers = jobs.live_workers();
-    if (workers >= 0) health["workers"] = workers;
-    send_json(res, 200, health);
-  });
+using Request = httplib::Request;
+using Response = httplib::Response;
+using Handler = void (*)(JobManager&, const ApiOptions&, const Request&, Response&);
 
-  svr.Get("/api/openapi.json", [openapi](const httplib::Request&, httplib::Response& res) {
-    res.set_content(openapi, "application/json");
-  });
+std::shared_ptr<Job> job_or_404(JobManager& jobs, const Request& req) {
+  auto job = jobs.get(req.matches[1]);  // ids are hex digits, so an odd one is no job
+  if (!job) throw JobError(JobErrorKind::not_found, "no job '" + std::string(req.matches[1]) + "'");
+  return job;
+}
 
-  svr.Get("/api/scenes", [&](const httplib::Request&, httplib::Response& res) {
-    send_json(res, 200, {{"scenes", jobs.scenes().list()}, {"defaults", job_spec_defaults()}});
-  });
+// ---- the service ----
 
-  svr.Post("/api/jobs/check", [&](const httplib::Request& req, httplib::Response& res) {
-    guarded(res, [&] {
-      JobSpec spec = jobs.check(parse_body(req));
-      send_json(res, 200, {{"valid", true}, {"spec", job_spec_to_json(spec)}});
-    });
-  });
+void get_health(JobManager& jobs, const ApiOptions&, const Request&, Response& res) {
+  size_t queued = 0, running = 0;
+  for (auto& j : jobs.list()) {
+    std::lock_guard<std::mutex> lock(j->mutex);
+    queued += j->state == JobState::queued;
+    running += j->state == JobState::running;
+  }
+  json health{{"status", "ok"}, {"queued", queued}, {"running", running}, {"rendering", jobs.backend_name()}};
+  StreamStats st = stream_stats();
+  health["stream"] = {{"watchers", st.watchers}, {"png_encodes", st.png_encodes}, {"tile_events", st.tile_events}};
+  int workers = jobs.live_workers();
+  if (workers >= 0) health["workers"] = workers;
+  send_json(res, 200, health);
+}
 
-  svr.Post("/api/jobs", [&](const httplib::Request& req, httplib::Response& res) {
-    guarded(res, [&] {
-      std::string key = req.get_header_value("Idempotency-Key");
-      if (key.size() > 200) throw ApiError(400, "Idempotency-Key is longer than 200 characters", "Idempotency-Key");
-      if (!valid_utf8(key)) throw ApiError(400, "Idempotency-Key is not valid UTF-8", "Idempotency-Key");
-      auto [job, created] = jobs.submit(parse_body(req), key);
-      std::lock_guard<std::mutex> lock(job->mutex);
-      res.set_header("Location", "/api/jobs/" + job->id);
-      send_json(res, created ? 201 : 200, jobs.status_json(*job));
-    });
-  });
+void get_openapi(JobManager&, const ApiOptions& options, const Request&, Response& res) {
+  res.set_content(options.openapi, "application/json");
+}
 
-  svr.Get("/api/jobs", [&](const httplib::Request&, httplib::Response& res) {
-    json list = json::array();
-    for (auto& j : jobs.list()) {
-      std::lock_guard<std::mutex> lock(j->mutex);
-      list.push_back(jobs.status_json(*j, false));
-    }
-    send_json(res, 200, {{"jobs", list}});
-  });
+// ---- scenes ----
 
-  svr.Get(R"(/api/jobs/([^/]+))", [&](const httplib::Request& req, httplib::Response& res) {
-    auto job = jobs.get(req.matches[1]);
-    if (!job) return send_error(res, 404, "no job '" + std::string(req.matches[1]) + "'");
+void list_scenes(JobManager& jobs, const ApiOptions&, const Request&, Response& res) {
+  send_json(res, 200, {{"scenes", jobs.scenes().list()}, {"defaults", job_spec_defaults()}});
+}
+
+// ---- jobs ----
+
+void check_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  JobSpec spec = jobs.check(parse_body(req));
+  send_json(res, 200, {{"valid", true}, {"spec", job_spec_to_json(spec)}});
+}
+
+void submit_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  std::string key = req.get_header_value("Idempotency-Key");
+  if (key.size() > 200) throw HttpError(400, "Idempotency-Key is longer than 200 characters", "Idempotency-Key");
+  if (!valid_utf8(key)) throw HttpError(400, "Idempotency-Key is not valid UTF-8", "Idempotency-Key");
+  auto [job, created] = jobs.submit(parse_body(req), key);
+  std::lock_guard<std::mutex> lock(job->mutex);
+  res.set_header("Location", "/api/jobs/" + job->id);
+  send_json(res, created ? 201 : 200, jobs.status_json(*job));
+}
+
+void list_jobs(JobManager& jobs, const ApiOptions&, const Request&, Response& res) {
+  json list = json::array();
+  for (auto& j : jobs.list()) {
+    std::lock_guard<std::mutex> lock(j->mutex);
+    list.push_back(jobs.status_json(*j, false));
+  }
+  send_json(res, 200, {{"jobs", list}});
+}
+
+void get_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  auto job = job_or_404(jobs, req);
+  std::lock_guard<std::mutex> lock(job->mutex);
+  send_json(res, 200, jobs.status_json(*job));
+}
+
+void cancel_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  jobs.cancel(req.matches[1]);
+  auto job = job_or_404(jobs, req);
+  std::lock_guard<std::mutex> lock(job->mutex);
+  send_json(res, 200, jobs.status_json(*job));
+}
+
+// ---- a job's image ----
+
+void get_image(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  auto job = job_or_404(jobs, req);
+  std::string ext = req.matches[2];
+  const char* type = ext == "png" ? "image/png" : "image/x-exr";
+  bool done, has_image;
+  std::string state;
+  {
     std::lock_guard<std::mutex> lock(job->mutex);
-    send_json(res, 200, jobs.status_json(*job));
-  });
+    done = job->state == JobState::done;
+    has_image = job->has_image;
+    state = job_state_name(job->state);
+  }
+  if (!done && !has_image) throw HttpError(404, "job has no image yet (state " + state + ")");
+  res.set_header("Cache-Control", "no-store");
+  std::string data;
+  // A done job's files (a regular file only: never a link or a FIFO someone put there).
+  if (done && read_file(jobs.job_dir(job->id) + "/image." + ext, data)) return res.set_content(data, type);
+  if (!has_image) throw HttpError(404, "the job's image is missing");
+  if (ext == "png") return res.set_content(current_png(*job), type);  // encoded once a pass for all
+  pt::ImageRGB img;
+  {
+    std::lock_guard<std::mutex> lock(job->mutex);
+    img.width = job->width;
+    img.height = job->height;
+    img.pixels.resize(size_t(img.width) * img.height);
+    std::memcpy(static_cast<void*>(img.pixels.data()), job->linear.data(), img.pixels.size() * sizeof(pt::Vec3));
+  }
+  res.set_content(pt::encode_exr(img), type);  // outside the mutex the render threads take
+}
 
-  svr.Delete(R"(/api/jobs/([^/]+))", [&](const httplib::Request& req, httplib::Response& res) {
-    guarded(res, [&] {
-      jobs.cancel(req.matches[1]);
-      auto job = jobs.get(req.matches[1]);
-      std::lock_guard<std::mutex> lock(job->mutex);
-      send_json(res, 200, jobs.status_json(*job));
-    });
-  });
+void get_focus(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  auto job = job_or_404(jobs, req);
+  auto coord = [&](const char* name) {
+    if (!req.has_param(name)) throw HttpError(400, std::string("query parameter '") + name + "' is required", name);
+    std::string v = req.get_param_value(name);
+    char* end = nullptr;
+    double d = std::strtod(v.c_str(), &end);
+    if (v.empty() || *end != '\0' || !std::isfinite(d))
+      throw HttpError(400, std::string("query parameter '") + name + "' must be a number", name);
+    return d;
+  };
+  double x = coord("x"), y = coord("y");
+  double d = jobs.focus_distance(*job, x, y);
+  send_json(res, 200, {{"x", x}, {"y", y}, {"distance", std::isfinite(d) ? json(d) : json(nullptr)}});
+}
 
-  svr.Get(R"(/api/jobs/([^/]+)/image\.(png|exr))", [&](const httplib::Request& req, httplib::Response& res) {
-    guarded(res, [&] {
-      auto job = jobs.get(req.matches[1]);
-      if (!job) throw ApiError(404, "no job '" + std::string(req.matches[1]) + "'");
-      std::string ext = req.matches[2];
-      const char* type = ext == "png" ? "image/png" : "image/x-exr";
-      bool done, has_image;
-      std::string state;
-      {
-        std::lock_guard<std::mutex> lock(job->mutex);
-        done = job->state == JobState::done;
-        has_image = job->has_image;
-        state = job_state_name(job->state);
-      }
-      if (!done && !has_image) throw ApiError(404, "job has no image yet (state " + state + ")");
-      res.set_header("Cache-Control", "no-store");
-      std::string data;
-      // A done job's files (a regular file only: never a link or a FIFO someone put there).
-      if (done && read_file(jobs.job_dir(job->id) + "/image." + ext, data)) return res.set_content(data, type);
-      if (!has_image) throw ApiError(404, "the job's image is missing");
-      if (ext == "png") return res.set_content(current_png(*job), type);  // encoded once a pass for all
-      pt::ImageRGB img;
-      {
-        std::lock_guard<std::mutex> lock(job->mutex);
-        img.width = job->width;
-        img.height = job->height;
-        img.pixels.resize(size_t(img.width) * img.height);
-        std::memcpy(static_cast<void*>(img.pixels.data()), job->linear.data(), img.pixels.size() * sizeof(pt::Vec3));
-      }
-      res.set_content(pt::encode_exr(img), type);  // outside the mutex the render threads take
-    });
+void watch_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  auto job = job_or_404(jobs, req);
+  res.set_header("Cache-Control", "no-cache");
+  res.set_header("X-Accel-Buffering", "no");
+  res.set_chunked_content_provider("text/event-stream", [&jobs, job](size_t, httplib::DataSink& sink) {
+    stream_events(jobs, job, sink);  // never throws
+    sink.done();
+    return true;
   });
+}
 
-  svr.Get(R"(/api/jobs/([^/]+)/focus)", [&](const httplib::Request& req, httplib::Response& res) {
-    guarded(res, [&] {
-      auto job = jobs.get(req.matches[1]);
-      if (!job) throw ApiError(404, "no job '" + std::string(req.matches[1]) + "'");
-      auto coord = [&](const char* name) {
-        if (!req.has_param(name)) throw ApiError(400, std::string("query parameter '") + name + "' is required", name);
-        std::string v = req.get_param_value(name);
-        char* end = nullptr;
-        double d = std::strtod(v.c_str(), &end);
-        if (v.empty() || *end != '\0' || !std::isfinite(d))
-          throw ApiError(400, std::string("query parameter '") + name + "' must be a number", name);
-        return d;
-      };
-      double x = coord("x"), y = coord("y");
-      double d = jobs.focus_distance(*job, x, y);
-      send_json(res, 200, {{"x", x}, {"y", y}, {"distance", std::isfinite(d) ? json(d) : json(nullptr)}});
-    });
-  });
+struct Route {
+  const char* method;
+  const char* path;  // a regular expression over the whole path; groups are the handler's matches
+  Handler handler;
+};
 
-  svr.Get(R"(/api/jobs/([^/]+)/events)", [&](const httplib::Request& req, httplib::Response& res) {
-    auto job = jobs.get(req.matches[1]);  // the id is hex digits only, or no job
-    if (!job) return send_error(res, 404, "no job '" + std::string(req.matches[1]) + "'");
-    res.set_header("Cache-Control", "no-cache");
-    res.set_header("X-Accel-Buffering", "no");
-    res.set_chunked_content_provider("text/event-stream", [&jobs, job](size_t, httplib::DataSink& sink) {
-      stream_events(jobs, job, sink);
-      sink.done();
-      return true;
-    });
-  });
+// Every route. openapi.json documents the same set (test_openapi.py checks each is there).
+const Route kRoutes[] = {
+    {"GET", "/api/health", get_health},
+    {"GET", "/api/openapi\\.json", get_openapi},
+    {"GET", "/api/scenes", list_scenes},
+    {"POST", "/api/jobs/check", check_job},
+    {"POST", "/api/jobs", submit_job},
+    {"GET", "/api/jobs", list_jobs},
+    {"GET", "/api/jobs/([^/]+)", get_job},
+    {"DELETE", "/api/jobs/([^/]+)", cancel_job},
+    {"GET", "/api/jobs/([^/]+)/image\\.(png|exr)", get_image},
+    {"GET", "/api/jobs/([^/]+)/focus", get_focus},
+    {"GET", "/api/jobs/([^/]+)/events", watch_job},
+};
+
+}  // namespace
+
+std::string allowed_methods(const std::string& path) {
+  static const std::vector<std::regex> patterns = [] {
+    std::vector<std::regex> out;
+    for (const Route& r : kRoutes) out.emplace_back(r.path);
+    return out;
+  }();
+  // A literal path ("/api/jobs/check") names its own methods, not those of a pattern it also fits.
+  auto methods = [&](bool literal) {
+    std::string allow;
+    for (const char* m : {"GET", "POST", "DELETE"})
+      for (size_t i = 0; i < patterns.size(); ++i)
+        if (kRoutes[i].method == std::string(m) && (std::strchr(kRoutes[i].path, '(') == nullptr) == literal &&
+            std::regex_match(path, patterns[i])) {
+          allow += (allow.empty() ? "" : ", ") + std::string(m);
+          break;
+        }
+    return allow;
+  };
+  std::string literal = methods(true);
+  return literal.empty() ? methods(false) : literal;
+}
+
+void install_routes(httplib::Server& svr, JobManager& jobs, const ApiOptions& options) {
+  ApiOptions guards = options;
+  guards.allowed_methods = allowed_methods;  // the 405's Allow header, from the same table
+  install_guards(svr, guards);
+  for (const Route& r : kRoutes) {
+    Handler handler = r.handler;
+    auto run = [&jobs, &options, handler](const Request& req, Response& res) {
+      guarded(res, [&] { handler(jobs, options, req, res); });
+    };
+    std::string method = r.method;
+    if (method == "GET") svr.Get(r.path, run);
+    else if (method == "POST") svr.Post(r.path, run);
+    else if (method == "DELETE") svr.Delete(r.path, run);
+  }
 }
 
 }  // namespace srv

@@ -66,7 +66,7 @@ std::string SceneLibrary::resolve(const std::string& name) const {
 
 std::string SceneLibrary::read_scene(const std::string& name, uint64_t* hash) const {
   std::string path = resolve(name);
-  if (path.empty()) throw ApiError(404, "unknown scene '" + name + "'", "scene");
+  if (path.empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "scene");
   // Checked before reading: the whole file is held in memory while it parses.
   struct stat st;
   if (stat(path.c_str(), &st) == 0 && size_t(st.st_size) > pt::LoadLimits().max_file_bytes)
@@ -75,7 +75,7 @@ std::string SceneLibrary::read_scene(const std::string& name, uint64_t* hash) co
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
-  if (!in) throw ApiError(404, "scene '" + name + "' cannot be read", "scene");
+  if (!in) throw JobError(JobErrorKind::not_found, "scene '" + name + "' cannot be read", "scene");
   std::string bytes = text.str();
   // FNV-1a over the content: an edited file is parsed again; identical files share one parse.
   uint64_t h = 1469598103934665603ull;

@@ -25,7 +25,7 @@ class SceneLibrary {
   // The file for a scene name, or "" when no configured directory holds it.
   std::string resolve(const std::string& name) const;
   // The scene's shared render base (a job makes its view with pt::make_view), built at most once
-  // per file content however many jobs ask at the same time. Throws ApiError(404) for an unknown
+  // per file content however many jobs ask at the same time. Throws JobError(not_found) for an unknown
   // name, pt::SceneError for a bad file.
   std::shared_ptr<const pt::SceneBase> load(const std::string& name);
   // A scene's summary (counts, materials, lights, the course camera's focus distance); parses a

@@ -2,7 +2,7 @@
 // server/job_spec.h): the Content-Type, Host, Origin, Sec-Fetch-Site and Range headers, the job
 // spec's JSON and scene names, and the UTF-8 repair every JSON answer relies on. The input is
 // newline-separated fields, the last one the body. Built only in build-fuzz by scripts/fuzz.sh.
-// A crash, a sanitizer report, an exception other than ApiError, or a broken invariant (trap) is a
+// A crash, a sanitizer report, an exception other than JobError, or a broken invariant (trap) is a
 // finding.
 #include <cstddef>
 #include <cstdint>
@@ -67,7 +67,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       srv::json back = srv::job_spec_to_json(spec);
       // What was accepted reads back as the same spec.
       require(srv::job_spec_to_json(srv::parse_job_spec(back)) == back);
-    } catch (const srv::ApiError&) {
+    } catch (const srv::JobError&) {
     }
   }
   return 0;
