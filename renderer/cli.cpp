@@ -2,6 +2,8 @@
 // "s:l:t:m:e:h:H:f:r:c:b:d:a:p:" with its multi-word -r, -a and -p.
 #include "cli.h"
 
+#include "options.h"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -22,7 +24,7 @@ long parse_int(const std::string& flag, const std::string& s, long lo, long hi) 
   return v;
 }
 
-float parse_float(const std::string& flag, const std::string& s, double lo, double hi) {
+double parse_float(const std::string& flag, const std::string& s, double lo, double hi) {
   char* end = nullptr;
   errno = 0;
   double v = std::strtod(s.c_str(), &end);
@@ -33,7 +35,14 @@ float parse_float(const std::string& flag, const std::string& s, double lo, doub
     std::snprintf(range, sizeof range, " is out of range [%g, %g]", lo, hi);
     throw UsageError(flag + ": " + s + range);
   }
-  return float(v);
+  return v;
+}
+
+// A flag's value for the render option `name`, in the option's range (options.h).
+double parse_option(const std::string& flag, const char* name, const std::string& s) {
+  const RenderOption& o = render_option(name);
+  if (o.type == OptionType::integer) return double(parse_int(flag, s, long(o.min), long(o.max)));
+  return parse_float(flag, s, o.min, o.max);
 }
 
 }  // namespace
@@ -48,24 +57,24 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
   };
   for (i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "-s") { need(a, 1); p.spp = int(parse_int(a, args[++i], 1, 1 << 24)); }
-    else if (a == "-l") { need(a, 1); p.light_samples = int(parse_int(a, args[++i], 1, 65536)); }
+    if (a == "-s") { need(a, 1); p.spp = int(parse_option(a, "spp", args[++i])); }
+    else if (a == "-l") { need(a, 1); p.light_samples = int(parse_option(a, "light_samples", args[++i])); }
     else if (a == "-t") { need(a, 1); p.threads = int(parse_int(a, args[++i], 1, 1024)); }
-    else if (a == "-m") { need(a, 1); p.max_depth = int(parse_int(a, args[++i], 0, 1000000)); }
+    else if (a == "-m") { need(a, 1); p.max_depth = int(parse_option(a, "max_depth", args[++i])); }
     else if (a == "-e") { need(a, 1); p.env_map = args[++i]; }
-    else if (a == "-b") { need(a, 1); p.lens_radius = parse_float(a, args[++i], 0, 1e6); }
-    else if (a == "-d") { need(a, 1); p.focal_distance = parse_float(a, args[++i], 0, 1e12); }
+    else if (a == "-b") { need(a, 1); p.lens_radius = float(parse_option(a, "aperture", args[++i])); }
+    else if (a == "-d") { need(a, 1); p.focal_distance = float(parse_option(a, "focal_distance", args[++i])); }
     else if (a == "-f") { need(a, 1); o.output = args[++i]; if (o.output.empty()) throw UsageError("-f: empty file name"); }
     else if (a == "-r") {
       need(a, 2);
-      p.width = int(parse_int(a, args[++i], 1, 16384));
-      p.height = int(parse_int(a, args[++i], 1, 16384));
+      p.width = int(parse_option(a, "width", args[++i]));
+      p.height = int(parse_option(a, "height", args[++i]));
     } else if (a == "-c") { need(a, 1); p.camera_file = args[++i]; }
     else if (a == "-a") {
       need(a, 2);
       p.adaptive = true;
-      p.adaptive_batch = int(parse_int(a, args[++i], 1, 1 << 24));
-      p.adaptive_tolerance = parse_float(a, args[++i], 0, 1e30);
+      p.adaptive_batch = int(parse_option(a, "adaptive_batch", args[++i]));
+      p.adaptive_tolerance = float(parse_option(a, "adaptive_tolerance", args[++i]));
     } else if (a == "-p") {
       need(a, 4);
       p.cell_x = int(parse_int(a, args[++i], 0, 16384));
@@ -90,11 +99,11 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--describe") { o.describe = true; }
     else if (a == "--error-log") { need(a, 1); o.error_log = args[++i]; }
     else if (a == "--reference") { need(a, 1); o.reference = args[++i]; }
-    else if (a == "--target-error") { need(a, 1); o.limits.target_error = parse_float(a, args[++i], 0, 1e30); }
-    else if (a == "--time-limit") { need(a, 1); o.limits.time_limit = parse_float(a, args[++i], 0, 1e9); }
+    else if (a == "--target-error") { need(a, 1); o.limits.target_error = parse_option(a, "target_error", args[++i]); }
+    else if (a == "--time-limit") { need(a, 1); o.limits.time_limit = parse_option(a, "time_limit", args[++i]); }
     else if (a == "--file-camera") { p.file_camera = true; }
-    else if (a == "--seed") { need(a, 1); p.seed = uint64_t(parse_int(a, args[++i], 0, 0x7fffffffffffffffL)); }
-    else if (a == "--tile") { need(a, 1); p.tile_size = int(parse_int(a, args[++i], 1, 4096)); }
+    else if (a == "--seed") { need(a, 1); p.seed = uint64_t(parse_option(a, "seed", args[++i])); }
+    else if (a == "--tile") { need(a, 1); p.tile_size = int(parse_option(a, "tile_size", args[++i])); }
     else if (a == "--quiet") { o.quiet = true; }
     else if (a == "--script") { need(a, 1); o.script = args[++i]; }
     else if (a.size() > 1 && a[0] == '-') { throw UsageError("unknown option '" + a + "'"); }
@@ -191,24 +200,21 @@ Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
     return s.str();
   };
   double pixels = double(session.width()) * session.height();
-  return {{"pathtracer:scene", o.scene_path},
-          {"pathtracer:spp", std::to_string(p.spp)},
-          {"pathtracer:achieved_spp", num(pixels > 0 ? st.samples / pixels : 0)},
-          {"pathtracer:light_samples", std::to_string(p.light_samples)},
-          {"pathtracer:max_depth", std::to_string(p.max_depth)},
-          {"pathtracer:lens_radius", num(p.lens_radius)},
-          {"pathtracer:focal_distance", num(p.focal_distance)},
-          {"pathtracer:adaptive", p.adaptive ? std::to_string(p.adaptive_batch) + " " + num(p.adaptive_tolerance) : "off"},
-          {"pathtracer:direct", p.hemisphere ? "hemisphere" : "light sampling"},
-          {"pathtracer:ray_packets",
-           p.ray_packets && !p.hemisphere ? std::to_string(session.scene().accel->packet_width()) : "off"},
-          {"pathtracer:caustic_light_paths", std::to_string(st.light_paths)},
-          {"pathtracer:environment", p.env_map},
-          {"pathtracer:seed", std::to_string(p.seed)},
-          {"pathtracer:threads", std::to_string(p.threads)},
-          {"pathtracer:wall_seconds", num(st.seconds)},
-          {"pathtracer:error_estimate", num(session.error_estimate())},
-          {"pathtracer:nonfinite_samples", std::to_string(st.nonfinite)}};
+  Metadata meta{{"pathtracer:scene", o.scene_path}};
+  for (const RenderOption& opt : render_options())  // every render option, from the one table
+    meta.push_back({opt.metadata, option_text(opt, opt.get(p, o.limits))});
+  Metadata run{{"pathtracer:achieved_spp", num(pixels > 0 ? st.samples / pixels : 0)},
+               {"pathtracer:direct", p.hemisphere ? "hemisphere" : "light sampling"},
+               {"pathtracer:ray_packets",
+                p.ray_packets && !p.hemisphere ? std::to_string(session.scene().accel->packet_width()) : "off"},
+               {"pathtracer:caustic_light_paths", std::to_string(st.light_paths)},
+               {"pathtracer:environment", p.env_map},
+               {"pathtracer:threads", std::to_string(p.threads)},
+               {"pathtracer:wall_seconds", num(st.seconds)},
+               {"pathtracer:error_estimate", num(session.error_estimate())},
+               {"pathtracer:nonfinite_samples", std::to_string(st.nonfinite)}};
+  meta.insert(meta.end(), run.begin(), run.end());
+  return meta;
 }
 
 std::string rate_image_path(const std::string& output) {

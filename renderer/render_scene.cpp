@@ -9,27 +9,28 @@
 #include <stdexcept>
 
 #include "materials.h"
+#include "options.h"
 #include "render.h"
 
 namespace pt {
 
 void RenderParams::validate() const {
   auto bad = [](const std::string& field, const std::string& why) { throw std::invalid_argument(field + ": " + why); };
-  if (spp < 1 || spp > (1 << 24)) bad("spp (-s)", "must be between 1 and 16777216");
-  if (light_samples < 1 || light_samples > 65536) bad("light_samples (-l)", "must be between 1 and 65536");
-  if (max_depth < 0 || max_depth > 1000000) bad("max_depth (-m)", "must be between 0 and 1000000");
+  // Every option's range from the one table (options.h); RunLimits are the driver's to check.
+  for (const RenderOption& o : render_options()) {
+    if (o.type == OptionType::boolean || std::string(o.name) == "time_limit" || std::string(o.name) == "target_error")
+      continue;
+    double v = o.get(*this, RunLimits());
+    if (!std::isfinite(v) || v < o.min || v > o.max)
+      bad(std::string(o.name) + " (" + o.flag + ")",
+          "must be " + std::string(o.type == OptionType::integer ? "between " : "finite and between ") +
+              option_text(o, o.min) + " and " + option_text(o, o.max));
+  }
   if (threads < 1 || threads > 1024) bad("threads (-t)", "must be between 1 and 1024");
-  if (!std::isfinite(lens_radius) || lens_radius < 0 || lens_radius > 1e6f) bad("lens_radius (-b)", "must be finite, >= 0 and <= 1e6");
-  if (!std::isfinite(focal_distance) || focal_distance < 0 || focal_distance > 1e12f)
-    bad("focal_distance (-d)", "must be finite and >= 0");
-  if (width < 1 || height < 1 || width > 16384 || height > 16384) bad("size (-r)", "width and height must be between 1 and 16384");
-  if (adaptive && (adaptive_batch < 1 || !std::isfinite(adaptive_tolerance) || adaptive_tolerance < 0))
-    bad("adaptive (-a)", "batch must be >= 1 and tolerance a finite number >= 0");
   if (cell_w != 0 || cell_h != 0) {
     if (cell_w < 1 || cell_h < 1 || cell_x < 0 || cell_y < 0 || cell_x + cell_w > width || cell_y + cell_h > height)
       bad("cell (-p)", "x y dx dy must lie inside the " + std::to_string(width) + "x" + std::to_string(height) + " frame");
   }
-  if (tile_size < 1 || tile_size > 4096) bad("tile_size", "must be between 1 and 4096");
 }
 
 CameraParams camera_params(const RenderParams& params) {

@@ -1,7 +1,9 @@
 // Job spec parsing: strict types, documented defaults, limits named in every error.
 #include "job_spec.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 
 namespace srv {
@@ -53,6 +55,21 @@ struct Reader {
 
 }  // namespace
 
+std::pair<double, double> job_range(const pt::RenderOption& o, const SpecLimits& lim) {
+  std::string name = o.name;
+  double hi = o.max, lo = o.min;
+  if (name == "width") hi = std::min(hi, double(lim.max_width));
+  if (name == "height") hi = std::min(hi, double(lim.max_height));
+  if (name == "spp") hi = std::min(hi, double(lim.max_spp));
+  if (name == "max_depth") hi = std::min(hi, double(lim.max_depth));
+  if (name == "light_samples") hi = std::min(hi, double(lim.max_light_samples));
+  if (name == "tile_size") {
+    lo = std::max(lo, double(lim.min_tile_size));
+    hi = std::min(hi, double(lim.max_tile_size));
+  }
+  return {lo, hi};
+}
+
 bool valid_scene_name(const std::string& name) {
   if (name.empty() || name.size() > 128) return false;
   if (!std::isalnum((unsigned char)name[0])) return false;
@@ -72,24 +89,20 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   s.scene = scene->get<std::string>();
   if (!valid_scene_name(s.scene))
     throw JobError(JobErrorKind::invalid, "'scene' must be a scene name (letters, digits, '_', '-', '.'; no paths)", "scene");
-  p.max_depth = int(r.integer("max_depth", 5, 0, lim.max_depth));
-  p.lens_radius = float(r.number("aperture", 0, 0, 1000));
-  p.focal_distance = float(r.number("focal_distance", 4.7, 0, 1e6));
-  p.spp = int(r.integer("spp", 64, 1, lim.max_spp));
-  p.light_samples = int(r.integer("light_samples", 1, 1, lim.max_light_samples));
-  p.width = int(r.integer("width", 480, 1, lim.max_width));
-  p.height = int(r.integer("height", 360, 1, lim.max_height));
-  p.seed = uint64_t(r.integer("seed", 0, 0, (1LL << 53)));
-  p.adaptive = r.boolean("adaptive", true);
-  p.adaptive_batch = int(r.integer("adaptive_batch", 32, 1, 65536));
-  p.adaptive_tolerance = float(r.number("adaptive_tolerance", 0.05, 0, 1));
-  p.hemisphere = r.boolean("hemisphere", false);
-  p.file_camera = r.boolean("file_camera", false);
-  p.keep_fov = r.boolean("keep_fov", false);
-  p.caustic_tracing = r.boolean("caustic_tracing", true);
-  p.tile_size = int(r.integer("tile_size", 32, 8, 256));
-  s.time_limit = r.number("time_limit", 0, 0, 7 * 86400);
-  s.target_error = r.number("target_error", 0, 0, 1);
+  pt::RunLimits run;
+  for (const pt::RenderOption& o : pt::render_options()) {  // every field from the one table
+    auto [lo, hi] = job_range(o, lim);
+    double v = o.service;
+    switch (o.type) {
+      case pt::OptionType::integer: v = double(r.integer(o.name, (long long)o.service, (long long)lo, (long long)hi)); break;
+      case pt::OptionType::real:
+      case pt::OptionType::number: v = r.number(o.name, o.service, lo, hi); break;
+      case pt::OptionType::boolean: v = r.boolean(o.name, o.service != 0) ? 1 : 0; break;
+    }
+    o.set(p, run, v);
+  }
+  s.time_limit = run.time_limit;
+  s.target_error = run.target_error;
   for (auto it = body.begin(); it != body.end(); ++it)
     if (!r.seen.count(it.key())) throw JobError(JobErrorKind::invalid, "unknown field '" + it.key() + "'", it.key());
   double pixel_samples = double(p.width) * p.height * p.spp;
@@ -107,39 +120,22 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   return s;
 }
 
-namespace {
-// The shortest decimal that reads back as the same float: 0.05f is written 0.05, not 0.0500000007.
-double short_float(float f) {
-  char buf[32];
-  for (int digits = 6; digits <= 9; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, double(f));
-    if (std::strtof(buf, nullptr) == f) break;
-  }
-  return std::strtod(buf, nullptr);
-}
-}  // namespace
-
 json job_spec_to_json(const JobSpec& s) {
-  const pt::RenderParams& p = s.params;
-  return json{{"scene", s.scene},
-              {"max_depth", p.max_depth},
-              {"aperture", short_float(p.lens_radius)},
-              {"focal_distance", short_float(p.focal_distance)},
-              {"spp", p.spp},
-              {"light_samples", p.light_samples},
-              {"width", p.width},
-              {"height", p.height},
-              {"seed", p.seed},
-              {"adaptive", p.adaptive},
-              {"adaptive_batch", p.adaptive_batch},
-              {"adaptive_tolerance", short_float(p.adaptive_tolerance)},
-              {"hemisphere", p.hemisphere},
-              {"file_camera", p.file_camera},
-              {"keep_fov", p.keep_fov},
-              {"caustic_tracing", p.caustic_tracing},
-              {"tile_size", p.tile_size},
-              {"time_limit", s.time_limit},
-              {"target_error", s.target_error}};
+  json j{{"scene", s.scene}};
+  pt::RunLimits run;
+  run.time_limit = s.time_limit;
+  run.target_error = s.target_error;
+  for (const pt::RenderOption& o : pt::render_options()) {
+    double v = o.get(s.params, run);
+    switch (o.type) {
+      case pt::OptionType::integer: j[o.name] = (long long)v; break;
+      // The shortest decimal that reads back as the same float: 0.05f is 0.05, not 0.0500000007.
+      case pt::OptionType::real: j[o.name] = std::strtod(pt::option_text(o, v).c_str(), nullptr); break;
+      case pt::OptionType::number: j[o.name] = v; break;
+      case pt::OptionType::boolean: j[o.name] = v != 0; break;
+    }
+  }
+  return j;
 }
 
 json job_spec_defaults() {

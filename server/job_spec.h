@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "options.h"
 #include "render.h"
 
 namespace srv {
@@ -49,14 +50,19 @@ struct JobSpec {
   double target_error = 0;    // stop when the error estimate reaches this; 0 = none
 };
 
+// The job service's policy: narrower ranges than the render options' own (renderer/options.h) where a
+// job would cost the shared server too much, or its watchers too many tiles.
 struct SpecLimits {
   int max_width = 4096, max_height = 4096, max_spp = 65536, max_depth = 10000, max_light_samples = 64;
+  int min_tile_size = 8, max_tile_size = 256;
   double max_pixel_samples = 4294967296.0;  // width * height * spp
 };
 
 // Parses a JSON body (already parsed) into a spec with defaults; throws JobError(invalid, ..., field).
 JobSpec parse_job_spec(const json& body, const SpecLimits& limits = {});
 json job_spec_to_json(const JobSpec& spec);
+// A render option's range for jobs: its own, narrowed by the server's policy.
+std::pair<double, double> job_range(const pt::RenderOption& option, const SpecLimits& limits);
 // The defaults and limits, as the API documents them.
 json job_spec_defaults();
 bool valid_scene_name(const std::string& name);

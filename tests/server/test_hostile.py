@@ -77,8 +77,8 @@ BODIES += [(f"{f}={v}", spec(**{f: v}), 400, f) for f, v in [
     ("adaptive_tolerance", -0.1), ("tile_size", 7), ("time_limit", -1), ("target_error", -0.5),
     ("width", 4097), ("height", 100000), ("spp", 65537), ("max_depth", 10001), ("light_samples", 65),
     ("seed", 2 ** 53 + 1), ("seed", 2 ** 64 - 1), ("seed", 2 ** 64), ("seed", -2 ** 63), ("adaptive_batch", 65537),
-    ("tile_size", 257), ("aperture", 1000.5), ("focal_distance", 1e7), ("adaptive_tolerance", 1.01),
-    ("time_limit", 604801), ("target_error", 1.5), ("width", 10 ** 30)]]
+    ("tile_size", 257), ("aperture", 1e6 + 1), ("focal_distance", 1.5e12), ("adaptive_tolerance", 1.01),
+    ("time_limit", 1e9 + 1), ("target_error", 1.5), ("width", 10 ** 30)]]
 BODIES += [
     # width x height x spp over the cap of 2^32 pixel samples (4096 x 4096 x 256 is exactly the cap)
     ("absurd size", {"scene": "cornell", "width": 4096, "height": 4096, "spp": 257}, 400, "spp"),
