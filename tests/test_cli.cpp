@@ -63,8 +63,10 @@ const char* kTinyScene = R"(<?xml version="1.0"?>
 </COLLADA>
 )";
 
+// Each test writes its own copy: ctest runs the tests of this file in parallel processes, and one
+// rewriting a file another is loading would make either fail.
 std::string write_tiny_scene() {
-  std::string path = test::temp_dir() + "/tiny.dae";
+  std::string path = test::temp_dir() + "/tiny_" + testing::UnitTest::GetInstance()->current_test_info()->name() + ".dae";
   std::ofstream(path) << kTinyScene;
   return path;
 }
