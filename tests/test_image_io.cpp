@@ -1,8 +1,9 @@
 // Image I/O through the OpenImageIO module (renderer/image_module.h): nothing of OpenImageIO is
 // mapped until the first image is read or written, and every function the module carries writes
-// what reads back.
+// what reads back. The course tone mapping and the error measures against values worked by hand.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <iterator>
 
@@ -74,6 +75,62 @@ TEST(ImageModule, PngHoldsTheCourseToneMapping) {
   back = read_image(path);
   for (size_t i = 0; i < back.pixels.size(); ++i)
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(back.pixels[i][c] * 255.0f, float(rgb[3 * i + c]), 1e-3f);
+}
+
+// The course curve clamp((sqrt(2) v)^(1/2.2), 0, 1) * 255, truncated, worked by hand:
+//   v = 0.5:   sqrt(2) v = 0.7071068, ln = -0.3465736, / 2.2 = -0.1575335, exp = 0.8542482, x 255 = 217.83 -> 217
+//   v = 0.1:   0.1414214, ln = -1.9560115, / 2.2 = -0.8890961, exp = 0.4110271, x 255 = 104.81 -> 104
+//   v = 0.001: 0.0014142, ln = -6.5611817, / 2.2 = -2.9823553, exp = 0.0506733, x 255 = 12.92 -> 12
+//   v = 0.72:  1.0182338 > 1, clamped -> 255;   v <= 0 and NaN -> 0.
+TEST(ToneMap, CourseCurveByHand) {
+  EXPECT_EQ(tonemap_course(0.5f), 217);
+  EXPECT_EQ(tonemap_course(0.1f), 104);
+  EXPECT_EQ(tonemap_course(0.001f), 12);
+  EXPECT_EQ(tonemap_course(0.72f), 255);
+  EXPECT_EQ(tonemap_course(1000.0f), 255);
+  EXPECT_EQ(tonemap_course(0.0f), 0);
+  EXPECT_EQ(tonemap_course(-1.0f), 0);
+  EXPECT_EQ(tonemap_course(NAN), 0);
+}
+
+// A written PNG holds those hand-worked levels, channel by channel.
+TEST(ToneMap, PngHoldsTheHandWorkedLevels) {
+  ImageRGB img;
+  img.width = 2;
+  img.height = 1;
+  img.pixels = {Vec3(0.5f, 0.1f, 0.001f), Vec3(0.72f, 0.0f, -1.0f)};
+  std::string path = test::temp_dir() + "/tonemap_by_hand.png";
+  write_image(img, path);
+  ImageRGB back = read_image(path);
+  ASSERT_EQ(back.width, 2);
+  const float levels[2][3] = {{217, 104, 12}, {255, 0, 0}};
+  for (int i = 0; i < 2; ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(back.pixels[i][c] * 255.0f, levels[i][c], 1e-3f) << i << " " << c;
+}
+
+// relative_mse = mean over pixels of (L - L_ref)^2 / (L_ref^2 + 0.01) on Rec. 709 luminance, worked
+// by hand on two pixels:
+//   red (1, 0, 0) against black: L = 0.2126, (0.2126)^2 / (0 + 0.01) = 0.04519876 / 0.01 = 4.519876
+//   grey 0.3 against grey 0.1 (the weights sum to 1): (0.2)^2 / (0.01 + 0.01) = 2
+//   mean (4.519876 + 2) / 2 = 3.259938. Swapped, the reference differs: 0.04519876 / 0.05519876 =
+//   0.8188365 and 0.04 / 0.1 = 0.4, mean 0.6094183.
+// rmse over the six channel differences (1, 0, 0, 0.2, 0.2, 0.2): sqrt(1.12 / 6) = 0.4320494.
+TEST(ErrorMeasures, RelativeMseAndRmseByHand) {
+  ImageRGB img, ref;
+  img.width = ref.width = 2;
+  img.height = ref.height = 1;
+  img.pixels = {Vec3(1, 0, 0), Vec3(0.3f)};
+  ref.pixels = {Vec3(0, 0, 0), Vec3(0.1f)};
+  EXPECT_NEAR(relative_mse(img, ref), 3.259938, 1e-5);
+  EXPECT_NEAR(relative_mse(ref, img), 0.6094183, 1e-5);
+  EXPECT_NEAR(rmse(img, ref), 0.4320494, 1e-6);
+  EXPECT_EQ(relative_mse(img, img), 0.0);
+  ImageRGB other;
+  other.width = 1;
+  other.height = 1;
+  other.pixels = {Vec3(1.0f)};
+  EXPECT_TRUE(std::isinf(relative_mse(img, other))) << "sizes differ";
+  EXPECT_TRUE(std::isinf(rmse(img, other))) << "sizes differ";
 }
 
 TEST(ImageModule, UnknownFormatAndUnreadableFileAreNamed) {

@@ -1,5 +1,5 @@
-// Image tests: analytic furnaces, estimator agreement, the course's depth sequence on CBspheres,
-// determinism across thread counts and cells. Tolerances come from the images' own noise.
+// Image tests: analytic furnaces, estimator agreement, the course's depth sequence (our Cornell
+// box, and CBspheres where ../shared has it), determinism across thread counts and cells. Tolerances come from the images' own noise.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -154,10 +154,10 @@ TEST(Furnace, DiffuseSphereUnderAUniformEnvironment) {
 }
 
 // Light sampling with MIS and the course's uniform-hemisphere estimator are both unbiased:
-// they must agree within noise on a scene lit by an area light.
+// they must agree within noise on a scene lit by an area light (our Cornell box: it needs no
+// ../shared).
 TEST(Estimators, LightSamplingAgreesWithHemisphereSampling) {
-  PT_REQUIRE_SHARED_SCENE(path, "CBspheres_lambertian.dae");
-  SceneDesc desc = load_collada(path);
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
   RenderParams p;
   p.width = 96;
   p.height = 72;
@@ -176,11 +176,13 @@ TEST(Estimators, LightSamplingAgreesWithHemisphereSampling) {
   EXPECT_GT(a.mean, 0.05);
 }
 
-// The course's depth sequence on CBspheres: m = 0 only the light; m = 1 both spheres dark;
-// m >= 3 the glass sphere transmits and a caustic appears under it.
-TEST(DepthSequence, CBspheresShowsTheCourseEffects) {
-  PT_REQUIRE_SHARED_SCENE(path, "CBspheres.dae");
-  SceneDesc desc = load_collada(path);
+namespace {
+
+// The course's depth sequence: m = 0 only the light; m = 1 both spheres dark; m >= 3 the glass
+// sphere transmits and a caustic appears under it. For a scene with one area light, one glass and
+// one mirror sphere: `wall` is a point of a wall in view, `caustic` where the glass sphere's
+// caustic lands on the floor, relative to the sphere's centre.
+void check_depth_sequence(const SceneDesc& desc, Vec3 wall, Vec3 caustic) {
   RenderParams p;
   p.width = 480;  // smaller sizes crop the light out of the course's view
   p.height = 360;
@@ -197,9 +199,8 @@ TEST(DepthSequence, CBspheresShowsTheCourseEffects) {
   ASSERT_TRUE(glass && mirror);
   Pixel glass_px = project(cam, glass->center), mirror_px = project(cam, mirror->center);
   Pixel light_px = project(cam, desc.lights[0].position);
-  Pixel wall_px = project(cam, Vec3(0, 0.9f, -1));
-  // The caustic lands on the floor under the sphere, pushed away from the light.
-  Pixel caustic_px = project(cam, glass->center + Vec3(0.1f, -glass->radius + 0.001f, 0.1f));
+  Pixel wall_px = project(cam, wall);
+  Pixel caustic_px = project(cam, glass->center + caustic);
   int disk = int(glass->radius / (length(glass->center - cam.position) * cam.tan_half_h) * p.height / 2);
   int r = int(0.3f * disk);  // the centre, where the glass sphere shows what lies behind it
   int rm = int(0.7f * disk);  // most of the mirror sphere, which reflects the walls
@@ -240,9 +241,27 @@ TEST(DepthSequence, CBspheresShowsTheCourseEffects) {
   }
 }
 
-TEST(Determinism, SameSeedSameImageWithOneOrTwoThreads) {
+}  // namespace
+
+// Our Cornell box (scenes/README.md): the back wall at z = -1, the glass sphere (r 0.3) resting on
+// the floor in front of the light, its caustic just in front of where it touches the floor.
+TEST(DepthSequence, CornellShowsTheCourseEffects) {
+  check_depth_sequence(load_collada(test::own_scene("cornell.dae")), Vec3(0, 0.4f, -1), Vec3(-0.04f, -0.299f, 0.12f));
+}
+
+// The course's CBspheres, where ../shared has it: the caustic pushed away from the light.
+TEST(DepthSequence, CBspheresShowsTheCourseEffects) {
   PT_REQUIRE_SHARED_SCENE(path, "CBspheres.dae");
   SceneDesc desc = load_collada(path);
+  float r = 0;
+  for (const SphereDesc& s : desc.spheres)
+    if (desc.materials[s.material].type == MaterialType::glass) r = s.radius;
+  check_depth_sequence(desc, Vec3(0, 0.9f, -1), Vec3(0.1f, -r + 0.001f, 0.1f));
+}
+
+// Our Cornell box, with mirror, glass and caustic light paths (no ../shared needed).
+TEST(Determinism, SameSeedSameImageWithOneOrTwoThreads) {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
   RenderParams p;
   p.width = 80;
   p.height = 60;
@@ -327,8 +346,7 @@ TEST(Schedule, TilesThatSeeTheSceneComeFirst) {
 }
 
 TEST(Determinism, CellRenderEqualsThatWindowOfTheFullFrame) {
-  PT_REQUIRE_SHARED_SCENE(path, "CBspheres.dae");
-  SceneDesc desc = load_collada(path);
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
   RenderParams p;
   p.width = 80;
   p.height = 60;

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include <cmath>
+#include <ctime>
 #include <string>
 
 #include "collada.h"
@@ -43,6 +44,14 @@ inline SceneDesc two_small_spheres() {
   d.spheres.push_back({"a", Vec3(-2, -1.5f, 0), 0.3f, 0});
   d.spheres.push_back({"b", Vec3(2, 1.5f, 0), 0.3f, 0});
   return d;
+}
+
+// CPU seconds this process has used (all threads). A bound on it holds whatever else the machine
+// runs, unlike a wall-clock bound: for "fails fast" checks, where hanging is the failure.
+inline double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 inline std::string own_scene(const std::string& name) { return std::string(PT_OWN_SCENES) + "/" + name; }

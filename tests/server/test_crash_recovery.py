@@ -2,7 +2,9 @@
 rendering and writing their images) and restarted on the same data directory each time. After
 every restart no job is lost (every job the server acknowledged is listed), every job is either
 done with images that decode completely (PNG and OpenEXR) or queued to run again, every job.json
-parses, and no temp file is left behind; at the end every job finishes."""
+parses, and no temp file is left behind; at the end every job finishes. Half the kills wait for
+a job to be rendering (a state, polled), with a job whose time limit keeps it rendering for a
+second whatever the machine's speed, so a fast machine still kills mid-render."""
 import json
 import random
 import time
@@ -17,6 +19,20 @@ def job_spec(rng, i):
     w, h = rng.choice(SIZES)
     return {"scene": "cornell", "width": w, "height": h, "spp": rng.choice([4, 16, 64]), "max_depth": 3,
             "adaptive": False, "seed": i, "tile_size": 16}
+
+
+def long_spec(i):
+    """Renders until its time limit (a second of wall time on any machine), then is done."""
+    return {"scene": "cornell", "width": 48, "height": 36, "spp": 65536, "max_depth": 3, "adaptive": False,
+            "seed": i, "tile_size": 16, "time_limit": 1.0}
+
+
+def wait_until_rendering(api, timeout=60):
+    """Polls /api/health until a job is running (states, not a clock; the timeout only stops a hang)."""
+    deadline = time.monotonic() + timeout
+    while api.get("/api/health").json()["running"] == 0:
+        assert time.monotonic() < deadline, "no job started rendering"
+        time.sleep(0.005)
 
 
 def check_data_dir(data, acknowledged, pid):
@@ -73,11 +89,17 @@ def test_kill_9_twenty_times_loses_nothing(servers):
                 done_seen.add(job_id)
             else:
                 assert job_id not in done_seen, f"job {job_id} was done and is not any more"
-        # More work, then a kill at a random moment: while queued, rendering, or writing images.
+        # More work, then a kill: every other round while a job renders, else at a random moment
+        # (while queued, rendering, or writing images).
         for _ in range(rng.choice([1, 2])):
             spec = job_spec(rng, len(specs))
             specs[api.submit(spec)["id"]] = spec
-        time.sleep(rng.uniform(0.02, 0.6))
+        if round_no % 2 == 0:
+            spec = long_spec(len(specs))
+            specs[api.submit(spec)["id"]] = spec
+            wait_until_rendering(api)
+        else:
+            time.sleep(rng.uniform(0.02, 0.6))
         kills_mid_render += api.get("/api/health").json()["running"] > 0
         srv.kill()
     # The last restart finishes everything.

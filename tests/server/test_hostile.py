@@ -12,6 +12,7 @@ from support import CORNELL, TINY, RawConnection, Server, raw_request
 INT_FIELDS = ["max_depth", "spp", "light_samples", "width", "height", "seed", "adaptive_batch", "tile_size"]
 NUM_FIELDS = ["aperture", "focal_distance", "adaptive_tolerance", "time_limit", "target_error"]
 BOOL_FIELDS = ["adaptive", "hemisphere", "file_camera", "keep_fov", "caustic_tracing"]
+READ_TIMEOUT = 120
 
 
 @pytest.fixture(scope="module")
@@ -25,7 +26,9 @@ def srv(tmp_path_factory, contract):
     outside.mkdir()
     (outside / "secret.dae").write_bytes(CORNELL.read_bytes())
     os.symlink(outside / "secret.dae", scenes / "escape.dae")  # points out of the scenes folder
-    server = Server(root, contract, scenes=scenes).start()
+    # A read timeout far beyond any answer's time, so that "answered at once, not at the read
+    # timeout" holds with a bound no load reaches (test_post_without_content_length_is_411_at_once).
+    server = Server(root, contract, scenes=scenes, args=["--read-timeout", str(READ_TIMEOUT)]).start()
     server.done_job = server.api.submit(TINY)
     server.api.wait(server.done_job["id"], "done", timeout=20)
     yield server
@@ -160,8 +163,8 @@ def check_raw_error(contract, status, headers, body, expected):
 def test_post_without_content_length_is_411_at_once(srv, contract):
     t0 = time.monotonic()
     status, headers, body = raw_request(srv.port, b"POST /api/jobs HTTP/1.1\r\nHost: 127.0.0.1\r\n"
-                                                  b"Content-Type: application/json\r\n\r\n")
-    assert time.monotonic() - t0 < 2  # not after the 10 s read timeout
+                                                  b"Content-Type: application/json\r\n\r\n", timeout=READ_TIMEOUT)
+    assert time.monotonic() - t0 < READ_TIMEOUT / 4  # not after the read timeout (it takes milliseconds)
     check_raw_error(contract, status, headers, body, 411)
 
 
@@ -238,7 +241,7 @@ def test_raw_request_is_refused(srv, contract, name, data, status):
         if status is not None and status >= 400 and status != 404:
             check_raw_error(contract, got, headers, body, status)
             assert headers.get("connection") == "close"
-        assert conn.closed_by_server(2), "the server kept a refused connection open"
+        assert conn.closed_by_server(20), "the server kept a refused connection open"
 
 
 # (name, bytes, statuses of the answers in order; None: the connection then closed)
@@ -275,7 +278,7 @@ def test_odd_but_valid_request(srv, name, data, statuses):
             assert got == status, (got, body[:300])
             assert "set-cookie" not in headers
         if statuses[-1] is None:
-            assert conn.closed_by_server(2)
+            assert conn.closed_by_server(20)
 
 
 # Static files (the page): nothing outside web/ is ever served.
@@ -358,14 +361,18 @@ def test_still_healthy_and_rendering_afterwards(srv):
     assert srv.alive()
     health = srv.api.get("/api/health").json()
     assert health["status"] == "ok"
-    # Requests on a kept-alive connection answer in about a millisecond (no Nagle / delayed-ACK
-    # stall of 40 ms between the header and body writes).
+    # No Nagle / delayed-ACK stall between the header and body writes on a kept-alive connection.
+    # That stall is a kernel timer (TCP_DELACK_MIN, 40 ms) that every request pays once the
+    # connection leaves quick-ACK mode (the first requests), so after those, one request of 20
+    # faster than 35 ms shows there is none; load only lengthens requests, it cannot shorten one.
+    for _ in range(20):
+        srv.api.get("/api/health")
     times = []
-    for _ in range(15):
+    for _ in range(20):
         t0 = time.monotonic()
         srv.api.get("/api/health")
         times.append(time.monotonic() - t0)
-    assert sorted(times)[len(times) // 2] < 0.025, times
+    assert min(times) < 0.035, times
     job = srv.api.submit(dict(TINY, seed=99))
     assert srv.api.wait(job["id"], "done", timeout=30)["state"] == "done"
     # Only the jobs the valid requests made exist.

@@ -1,6 +1,7 @@
 """Late and reconnecting watchers start from the whole current picture: the first event is an
 image of the full size (also with Last-Event-ID, and for a finished job), and painting the
-stream from there ends at the final image."""
+stream from there ends at the final image. The job being still running when the late watcher
+connects is checked from its status event, not assumed from a clock."""
 import base64
 
 from support import TINY, Canvas, decode_png
@@ -18,17 +19,29 @@ def paint(canvas, events):
             canvas.paint_tile(ev.data)
 
 
+def late_watcher_of_a_running_job(server, spec, tries=5):
+    """Submits `spec` and connects once it has a picture; returns (job, stream, first two events)
+    with the job still running then. A job that reached its time limit first (the test process
+    starved that long) is followed by one with twice the limit: states decide, not a clock."""
+    for _ in range(tries):
+        job = server.api.submit(spec)
+        server.api.wait(job["id"], ("running", "done"), samples=96 * 72 * 2)  # past the first passes
+        late = server.events(job["id"])
+        first, second = late.next(), late.next()
+        if second.kind == "status" and second.data["state"] == "running":
+            return job, late, first, second
+        late.close()
+        server.api.wait(job["id"], "done", timeout=60)
+        spec = dict(spec, time_limit=2 * spec["time_limit"])
+    raise AssertionError(f"no job was still running when its late watcher connected, {tries} tries")
+
+
 def test_late_connect_and_reconnect_with_last_event_id(server):
     api = server.api
-    job = api.submit(LONG)
-    api.wait(job["id"], "running", samples=96 * 72 * 2)  # past the first passes: there is a picture
-
     # A late watcher: the first event is the full current image, then status.
-    late = server.events(job["id"])
-    first = late.next()
+    job, late, first, second = late_watcher_of_a_running_job(server, LONG)
     assert first.kind == "image" and (first.data["width"], first.data["height"]) == (96, 72)
     assert decode_png(base64.b64decode(first.data["png"]))[:2] == (96, 72)
-    second = late.next()
     assert second.kind == "status" and second.data["state"] == "running" and second.id == first.id
     last_id = second.id
     for ev in late:  # read on to a tile, then drop the connection

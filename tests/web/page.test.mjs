@@ -6,7 +6,8 @@
 //   PT_WEB_ARTIFACTS  where the screenshots go (default: <source>/build/tests)
 //   CHROMIUM        the browser (default: /usr/bin/chromium)
 //
-// Exits 77 (ctest: skipped) when the browser, playwright-core or the server binary is missing.
+// Exits 77 (ctest: skipped) when the browser, playwright-core or the server binary is missing;
+// under CI=true those are failures (exit 1): missing.mjs.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
@@ -14,6 +15,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { skip } from './missing.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const sourceDir = path.resolve(process.env.PT_SOURCE_DIR || path.join(here, '..', '..'));
@@ -21,10 +23,6 @@ const serverBin = process.env.RENDER_SERVER || path.join(sourceDir, 'build', 're
 const artifacts = process.env.PT_WEB_ARTIFACTS || path.join(sourceDir, 'build', 'tests');
 const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
 
-function skip(why) {
-  console.log(`SKIP: ${why}`);
-  process.exit(77);
-}
 if (!fs.existsSync(serverBin)) skip(`no render-server at ${serverBin}`);
 if (!fs.existsSync(chromiumPath)) skip(`no browser at ${chromiumPath} (apt-get install chromium)`);
 let chromium;

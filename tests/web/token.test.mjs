@@ -2,7 +2,7 @@
 // driven by playwright-core): the token given in the address's fragment (#token=...) is taken out
 // of the address bar and sent on every API call, in the event stream's query (EventSource cannot
 // send headers) and in the image links; without it the page asks for it once and then works.
-// Same environment and skip rules (exit 77) as page.test.mjs.
+// Same environment and skip rules (exit 77; under CI=true, 1) as page.test.mjs.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
@@ -10,6 +10,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { skip } from './missing.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const sourceDir = path.resolve(process.env.PT_SOURCE_DIR || path.join(here, '..', '..'));
@@ -18,10 +19,6 @@ const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
 const WAIT = Number(process.env.PT_WEB_WAIT_MS) || 90_000;
 const TOKEN = 'web-t0ken&with=odd#chars';
 
-function skip(why) {
-  console.log(`SKIP: ${why}`);
-  process.exit(77);
-}
 if (!fs.existsSync(serverBin)) skip(`no render-server at ${serverBin}`);
 if (!fs.existsSync(chromiumPath)) skip(`no browser at ${chromiumPath} (apt-get install chromium)`);
 let chromium;
