@@ -191,7 +191,9 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
     std::atomic<int>& n;
     ~Count() { --n; }
   } count{m_open};
-  if (++m_open > m_limits.max_connections) {
+  // Served on the accepting thread: every thread is busy and connections are queued, so this one
+  // is over capacity whatever the count says.
+  if (++m_open > m_limits.max_connections || t_on_accept_thread) {
     // Over the cap: answer at once without reading, so a flood of idle or slow connections
     // cannot queue up the server's threads.
     std::string body = "{\"error\":{\"status\":503,\"message\":\"too many open connections (limit " +
@@ -243,7 +245,9 @@ BoundedThreadPool::~BoundedThreadPool() { shutdown(); }
 void BoundedThreadPool::enqueue(std::function<void()> fn) {
   {
     std::lock_guard<std::mutex> lock(m_mutex);
-    if (m_jobs.size() < m_max_pending) {
+    // Idle threads take queued connections at once (a burst of watchers waits here only for a
+    // thread to wake); only past them do connections count against the bound.
+    if (m_jobs.size() < m_max_pending + m_idle) {
       m_jobs.push_back(std::move(fn));
       m_cv.notify_one();
       return;
@@ -270,7 +274,9 @@ void BoundedThreadPool::work() {
     std::function<void()> fn;
     {
       std::unique_lock<std::mutex> lock(m_mutex);
+      ++m_idle;
       m_cv.wait(lock, [&] { return m_shutdown || !m_jobs.empty(); });
+      --m_idle;
       if (m_jobs.empty()) return;  // shut down, nothing left
       fn = std::move(m_jobs.front());
       m_jobs.pop_front();

@@ -62,6 +62,7 @@ class BoundedThreadPool : public httplib::TaskQueue {
   std::deque<std::function<void()>> m_jobs;
   std::vector<std::thread> m_threads;
   bool m_shutdown = false;
+  size_t m_idle = 0;  // threads waiting for a connection
 };
 
 // Why reading the current thread's request failed, for the error handler to answer 408 or 431

@@ -31,26 +31,37 @@ struct Encodings {
   int image_png_width = 0, image_png_height = 0;
   uint64_t image_png_pass = ~uint64_t(0), image_png_version = 0;
   double image_png_time = 0;  // steady seconds when it was encoded
+  std::atomic<size_t> bytes{0};  // what the encodings above hold, about
 };
 
-// The encodings of the jobs clients asked for most recently; a job's stay while a stream or a
-// request holds them, and until kCachedJobs others are asked for after it.
-constexpr size_t kCachedJobs = 32;
+// The encodings of the jobs clients asked for most recently. A job's stay while a stream or a
+// request holds them; the others go, least recently asked for first, once the cache holds more than
+// kCacheBytes (a 4096x4096 job's encodings alone take about 70 MB) or kCachedJobs jobs.
+constexpr size_t kCachedJobs = 32, kCacheBytes = size_t(256) << 20;
 std::mutex g_cache_mutex;
 std::vector<std::pair<std::string, std::shared_ptr<Encodings>>> g_cache;  // most recent last
 
 std::shared_ptr<Encodings> encodings_for(const Job& job) {
   std::lock_guard<std::mutex> lock(g_cache_mutex);
-  for (size_t i = 0; i < g_cache.size(); ++i)
+  std::shared_ptr<Encodings> found;
+  for (size_t i = 0; i < g_cache.size() && !found; ++i)
     if (g_cache[i].first == job.id) {
-      auto hit = g_cache[i];
+      found = g_cache[i].second;
       g_cache.erase(g_cache.begin() + long(i));
-      g_cache.push_back(hit);
-      return hit.second;
     }
-  if (g_cache.size() >= kCachedJobs) g_cache.erase(g_cache.begin());
-  g_cache.push_back({job.id, std::make_shared<Encodings>()});
-  return g_cache.back().second;
+  if (!found) found = std::make_shared<Encodings>();
+  size_t total = found->bytes;
+  for (const auto& entry : g_cache) total += entry.second->bytes;
+  for (size_t i = 0; i < g_cache.size() && (total > kCacheBytes || g_cache.size() >= kCachedJobs);) {
+    if (g_cache[i].second.use_count() > 1) {  // a stream or a request holds it
+      ++i;
+      continue;
+    }
+    total -= g_cache[i].second->bytes;
+    g_cache.erase(g_cache.begin() + long(i));
+  }
+  g_cache.push_back({job.id, found});
+  return found;
 }
 
 std::string encode_png(const std::vector<uint8_t>& rgb, int w, int h) {
@@ -145,8 +156,10 @@ std::vector<std::shared_ptr<const std::string>> changed_regions(Job& job, Encodi
     char head[128];
     std::snprintf(head, sizeof head, "event: tile\ndata: {\"x\":%d,\"y\":%d,\"w\":%d,\"h\":%d,\"png\":\"", s.x, s.y, s.w,
                   s.h);
+    size_t before = enc.region_event[s.index] ? enc.region_event[s.index]->size() : 0;
     enc.region_event[s.index] =
         std::make_shared<const std::string>(head + base64(encode_png(s.rgb, s.w, s.h)) + "\"}\n\n");
+    enc.bytes += enc.region_event[s.index]->size() - before;
     enc.region_event_version[s.index] = s.version;
     enc.region_event_time[s.index] = steady_seconds();
   }
@@ -192,6 +205,7 @@ Snapshot snapshot_png(Job& job) {
     pass = job.passes;
   }
   s.png = encode_png(rgb, s.width, s.height);  // outside the mutex the render threads take
+  enc.bytes += s.png.size() - enc.image_png.size();  // unsigned wrap-around cancels out
   enc.image_png = s.png;
   enc.image_png_width = s.width;
   enc.image_png_height = s.height;
