@@ -13,8 +13,6 @@
 
 namespace srv {
 
-double now_unix_seconds();
-
 class JobStateSink : public JobSink {
  public:
   JobStateSink(Job& job, std::function<void(Job&)> persist) : m_job(job), m_persist(std::move(persist)) {}

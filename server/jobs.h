@@ -20,6 +20,9 @@ namespace srv {
 
 class RenderBackend;
 
+// Seconds since the Unix epoch: the job timestamps' clock.
+double now_unix_seconds();
+
 enum class JobState { queued, running, done, failed, cancelled };
 const char* job_state_name(JobState s);
 bool parse_job_state(const std::string& s, JobState* out);

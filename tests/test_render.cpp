@@ -31,33 +31,9 @@ ImageRGB render(const SceneDesc& desc, const RenderParams& p, SessionStats* stat
 // A diffuse sphere (albedo rho, radius 1, at the origin) with a camera node at `camera_z`
 // looking down -z and optionally a point light of intensity 1 at the origin.
 std::string sphere_scene(float rho, float camera_z, bool point_light) {
-  std::ostringstream s;
-  s << R"(<?xml version="1.0"?>
-<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
-  <asset><up_axis>Y_UP</up_axis></asset>
-  <library_cameras><camera id="C"><optics><technique_common><perspective>
-    <xfov>30</xfov><aspect_ratio>1</aspect_ratio><znear>0.001</znear><zfar>1000</zfar>
-  </perspective></technique_common></optics></camera></library_cameras>
-  <library_lights><light id="L"><technique_common><point><color>1 1 1</color>
-    <constant_attenuation>1</constant_attenuation><linear_attenuation>0</linear_attenuation>
-    <quadratic_attenuation>0</quadratic_attenuation></point></technique_common></light></library_lights>
-  <library_effects><effect id="E"><profile_COMMON><technique sid="common"><phong>
-    <diffuse><color>)" << rho << " " << rho << " " << rho << R"( 1</color></diffuse>
-  </phong></technique></profile_COMMON></effect></library_effects>
-  <library_materials><material id="M"><instance_effect url="#E"/></material></library_materials>
-  <library_geometries>
-    <geometry id="S"><extra><technique profile="CGL"><sphere><radius>1</radius></sphere></technique></extra></geometry>
-  </library_geometries>
-  <library_visual_scenes><visual_scene id="VS">
-    <node id="cam"><translate>0 0 )" << camera_z << R"(</translate><instance_camera url="#C"/></node>
-    )" << (point_light ? R"(<node id="l"><instance_light url="#L"/></node>)" : "") << R"(
-    <node id="s"><instance_geometry url="#S"><bind_material><technique_common>
-      <instance_material symbol="M" target="#M"/></technique_common></bind_material></instance_geometry></node>
-  </visual_scene></library_visual_scenes>
-  <scene><instance_visual_scene url="#VS"/></scene>
-</COLLADA>
-)";
-  return s.str();
+  return test::diffuse_sphere_scene(rho, camera_z, 30, point_light ? "<point><color>1 1 1</color>"
+      "<constant_attenuation>1</constant_attenuation><linear_attenuation>0</linear_attenuation>"
+      "<quadratic_attenuation>0</quadratic_attenuation></point>" : "");
 }
 
 // Mean over the whole image with a tolerance of `sigmas` standard errors (pixels are independent).

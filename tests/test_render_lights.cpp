@@ -13,39 +13,9 @@
 
 using namespace pt;
 using test::RegionStats;
+using test::diffuse_sphere_scene;
 
 namespace {
-
-// A diffuse sphere (albedo rho, radius 1, at the origin), a camera at (0, 0, camera_z) looking
-// down -z with horizontal field of view `fov`, and one light at the origin given as its
-// technique_common element.
-std::string scene(float rho, float camera_z, float fov, const std::string& light) {
-  std::ostringstream s;
-  s << R"(<?xml version="1.0"?>
-<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
-  <asset><up_axis>Y_UP</up_axis></asset>
-  <library_cameras><camera id="C"><optics><technique_common><perspective>
-    <xfov>)" << fov << R"(</xfov><aspect_ratio>1</aspect_ratio><znear>0.001</znear><zfar>1000</zfar>
-  </perspective></technique_common></optics></camera></library_cameras>
-  <library_lights><light id="L"><technique_common>)" << light << R"(</technique_common></light></library_lights>
-  <library_effects><effect id="E"><profile_COMMON><technique sid="common"><phong>
-    <diffuse><color>)" << rho << " " << rho << " " << rho << R"( 1</color></diffuse>
-  </phong></technique></profile_COMMON></effect></library_effects>
-  <library_materials><material id="M"><instance_effect url="#E"/></material></library_materials>
-  <library_geometries>
-    <geometry id="S"><extra><technique profile="CGL"><sphere><radius>1</radius></sphere></technique></extra></geometry>
-  </library_geometries>
-  <library_visual_scenes><visual_scene id="VS">
-    <node id="cam"><translate>0 0 )" << camera_z << R"(</translate><instance_camera url="#C"/></node>
-    <node id="l"><instance_light url="#L"/></node>
-    <node id="s"><instance_geometry url="#S"><bind_material><technique_common>
-      <instance_material symbol="M" target="#M"/></technique_common></bind_material></instance_geometry></node>
-  </visual_scene></library_visual_scenes>
-  <scene><instance_visual_scene url="#VS"/></scene>
-</COLLADA>
-)";
-  return s.str();
-}
 
 RenderParams params(int spp, int max_depth) {
   RenderParams p;
@@ -92,7 +62,7 @@ TEST(SpotRender, FallOffInsideADiffuseSphereMatchesTheFormula) {
   const float rho = 0.6f, intensity = 5, exponent = 3;
   const std::string spot = "<spot><color>5 5 5</color><falloff_angle>24</falloff_angle><falloff_exponent>3"
                            "</falloff_exponent></spot>";
-  SceneDesc desc = parse_collada(scene(rho, 0, 30, spot), "spot.dae");
+  SceneDesc desc = parse_collada(diffuse_sphere_scene(rho, 0, 30, spot), "spot.dae");
   ASSERT_EQ(desc.lights.size(), 1u);
   ASSERT_EQ(desc.lights[0].type, LightType::spot);
   RenderParams p = params(16, 1);
@@ -126,7 +96,7 @@ TEST(SpotRender, FallOffInsideADiffuseSphereMatchesTheFormula) {
 // normal n shows rho C (1 + n_y) / 2 at any depth.
 TEST(AmbientRender, DiffuseSphereUnderTheSkyMatchesTheFormula) {
   const float rho = 0.7f, sky = 2;
-  SceneDesc desc = parse_collada(scene(rho, 20, 7, "<ambient><color>2 2 2</color></ambient>"), "ambient.dae");
+  SceneDesc desc = parse_collada(diffuse_sphere_scene(rho, 20, 7, "<ambient><color>2 2 2</color></ambient>"), "ambient.dae");
   ASSERT_EQ(desc.lights.size(), 1u);
   ASSERT_EQ(desc.lights[0].type, LightType::ambient);
   for (int m : {1, 3}) {

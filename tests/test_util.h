@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <ctime>
+#include <sstream>
 #include <string>
 
 #include "collada.h"
@@ -14,6 +15,38 @@
 #include "simd.h"
 
 namespace pt::test {
+
+// A diffuse sphere (albedo rho, radius 1, at the origin), a camera at (0, 0, camera_z) looking
+// down -z with horizontal field of view `fov`, and one light at the origin given as its
+// technique_common element ("" for no light).
+inline std::string diffuse_sphere_scene(float rho, float camera_z, float fov, const std::string& light) {
+  std::ostringstream s;
+  s << R"(<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><up_axis>Y_UP</up_axis></asset>
+  <library_cameras><camera id="C"><optics><technique_common><perspective>
+    <xfov>)" << fov << R"(</xfov><aspect_ratio>1</aspect_ratio><znear>0.001</znear><zfar>1000</zfar>
+  </perspective></technique_common></optics></camera></library_cameras>
+  )" << (light.empty() ? "" : "<library_lights><light id=\"L\"><technique_common>" + light +
+                                 "</technique_common></light></library_lights>") << R"(
+  <library_effects><effect id="E"><profile_COMMON><technique sid="common"><phong>
+    <diffuse><color>)" << rho << " " << rho << " " << rho << R"( 1</color></diffuse>
+  </phong></technique></profile_COMMON></effect></library_effects>
+  <library_materials><material id="M"><instance_effect url="#E"/></material></library_materials>
+  <library_geometries>
+    <geometry id="S"><extra><technique profile="CGL"><sphere><radius>1</radius></sphere></technique></extra></geometry>
+  </library_geometries>
+  <library_visual_scenes><visual_scene id="VS">
+    <node id="cam"><translate>0 0 )" << camera_z << R"(</translate><instance_camera url="#C"/></node>
+    )" << (light.empty() ? "" : R"(<node id="l"><instance_light url="#L"/></node>)") << R"(
+    <node id="s"><instance_geometry url="#S"><bind_material><technique_common>
+      <instance_material symbol="M" target="#M"/></technique_common></bind_material></instance_geometry></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#VS"/></scene>
+</COLLADA>
+)";
+  return s.str();
+}
 
 // Tests that run the SSE2 paths on an AVX2 machine (simd::allow_avx2(false)) hold one of these: a
 // failed ASSERT must not leave the AVX2 paths off for the tests after it.
