@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "args.h"
-#include "render.h"
+#include "session.h"
 
 namespace bench {
 

@@ -27,7 +27,7 @@
 #include "minimal_loop.h"
 #include "minimal_loop_lanes.h"
 #include "progress.h"
-#include "render.h"
+#include "session.h"
 
 using namespace pt;
 using namespace bench;

@@ -20,7 +20,7 @@
 #include "collada.h"
 #include "plot.h"
 #include "progress.h"
-#include "render.h"
+#include "session.h"
 
 using namespace pt;
 using namespace bench;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "args.h"
-#include "film.h"
+#include "session.h"
 
 namespace {
 
@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
     for (int y = 0; y < s.h; y += params.tile_size)
       for (int x = 0; x < s.w; x += params.tile_size)
         tiles.push_back({x, y, std::min(x + params.tile_size, s.w), std::min(y + params.tile_size, s.h)});
-    pt::FilmAccumulator film(params, s.w, s.h);
+    pt::Film film(s.w, s.h, params.spp, pt::adaptive_rule(params), false);
     std::mt19937 rng(1);
     std::vector<double> enc, dec, mer, til;
     size_t bytes = 0;

@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "render.h"
+#include "session.h"
 #include "rng.h"
 #include "sampling.h"
 

@@ -12,7 +12,7 @@
 #include "bench_common.h"
 #include "collada.h"
 #include "progress.h"
-#include "render.h"
+#include "session.h"
 
 using namespace pt;
 using namespace bench;

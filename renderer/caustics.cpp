@@ -7,7 +7,7 @@
 
 #include "accel.h"
 #include "materials.h"
-#include "render.h"
+#include "integrator.h"
 #include "sampler.h"
 
 namespace pt {

@@ -1,139 +1,122 @@
+// The film (film.h): per-pixel statistics, merging, images, and the error estimate.
 #include "film.h"
 
-#include <cmath>
-#include <cstring>
+#include <atomic>
+#include <cstdio>
 #include <stdexcept>
+#include <thread>
+
+#include <sys/mman.h>
+
+#include "caustics.h"
+#include "film_pass.h"
 
 namespace pt {
 
 namespace {
 
-constexpr char kMagic[8] = {'P', 'T', 'F', 'I', 'L', 'M', '2', 0};
-
-struct Header {
-  char magic[8];
-  uint32_t width, height, first, count;
-  uint64_t rays, nonfinite;
-  double seconds;
-  uint64_t light_paths;
-  uint32_t has_caustics, unused;  // caustic sums follow the sample counts
-};
-
+// A zero-filled per-pixel array. A 1920x1080 session's come to about 95 MB, and faulting them in
+// 4 KiB pages took about 65 ms of kernel time per session (perf stat: 24k page faults). Asked for
+// transparent huge pages before the first touch, the kernel maps 2 MiB at a fault where it can
+// (THP "madvise" or "always"); elsewhere the advice is ignored.
 template <class T>
-void append(std::string& out, const std::vector<T>& v) {
-  out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+void assign_zeroed(std::vector<T>& v, size_t n, const T& zero) {
+  v.reserve(n);
+#ifdef MADV_HUGEPAGE
+  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+  const uintptr_t lo = (reinterpret_cast<uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t hi = (reinterpret_cast<uintptr_t>(v.data()) + n * sizeof(T)) & ~(kHuge - 1);
+  if (hi >= lo + 2 * kHuge) madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
+#endif
+  v.assign(n, zero);
 }
 
-template <class T>
-void extract(const std::string& in, size_t& at, std::vector<T>& v, size_t n) {
-  v.resize(n);
-  std::memcpy(v.data(), in.data() + at, n * sizeof(T));
-  at += n * sizeof(T);
+// Course colouring: 0 = blue, 0.5 = green, 1 = red, by samples taken / spp.
+Vec3 rate_colour(uint32_t count, int spp) {
+  float r = float(count) / float(spp);
+  return r <= 0.5f ? Vec3(0, 2 * r, 1 - 2 * r) : Vec3(2 * r - 1, 2 - 2 * r, 0);
 }
 
 }  // namespace
 
-// The hosts we run on are little-endian; the encoding is the in-memory layout behind a header.
-static_assert(sizeof(Vec3) == 12, "Vec3 must be three packed floats");
-
-std::string FilmPass::encode() const {
-  Header h;
-  std::memcpy(h.magic, kMagic, sizeof kMagic);
-  h.width = uint32_t(width);
-  h.height = uint32_t(height);
-  h.first = first;
-  h.count = count;
-  h.rays = rays;
-  h.nonfinite = nonfinite;
-  h.seconds = seconds;
-  h.light_paths = light_paths;
-  h.has_caustics = caustic_sum.empty() ? 0 : 1;
-  h.unused = 0;
-  std::string out(reinterpret_cast<const char*>(&h), sizeof h);
-  append(out, sum);
-  append(out, lum2);
-  append(out, samples);
-  append(out, caustic_sum);
-  return out;
+Film::Film(int width, int height, int spp, const AdaptiveRule& rule, bool caustics)
+    : m_w(width), m_h(height), m_spp(spp), m_rule(rule) {
+  m_rule.batch = std::max(1u, m_rule.batch);
+  const size_t n = size_t(width) * size_t(height);
+  assign_zeroed(m_sum, n, Vec3(0.0f));
+  assign_zeroed(m_s1, n, 0.0);
+  assign_zeroed(m_s2, n, 0.0);
+  assign_zeroed(m_half_s1, n, 0.0);
+  assign_zeroed(m_half_n, n, 0u);
+  assign_zeroed(m_count, n, 0u);
+  assign_zeroed(m_done, n, uint8_t(0));
+  if (caustics) {
+    assign_zeroed(m_lt_sum, n, Vec3(0.0f));
+    assign_zeroed(m_lt_s1, n, 0.0);
+    assign_zeroed(m_lt_half_s1, n, 0.0);
+  }
 }
 
-FilmPass FilmPass::decode(const std::string& bytes, int expect_width, int expect_height) {
-  Header h;
-  if (bytes.size() < sizeof h) throw std::runtime_error("film pass: " + std::to_string(bytes.size()) + " bytes is too short");
-  std::memcpy(&h, bytes.data(), sizeof h);
-  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) throw std::runtime_error("film pass: not a PTFILM2 buffer");
-  if (h.has_caustics > 1) throw std::runtime_error("film pass: bad caustics flag");
-  if (int(h.width) != expect_width || int(h.height) != expect_height)
-    throw std::runtime_error("film pass: " + std::to_string(h.width) + "x" + std::to_string(h.height) + " film, expected " +
-                             std::to_string(expect_width) + "x" + std::to_string(expect_height));
-  size_t n = size_t(h.width) * h.height;
-  if (bytes.size() != sizeof h + n * (sizeof(Vec3) + sizeof(float) + sizeof(uint32_t) + h.has_caustics * sizeof(Vec3)))
-    throw std::runtime_error("film pass: " + std::to_string(bytes.size()) + " bytes does not match a " +
-                             std::to_string(h.width) + "x" + std::to_string(h.height) + " film");
-  FilmPass p;
-  p.width = int(h.width);
-  p.height = int(h.height);
-  p.first = h.first;
-  p.count = h.count;
-  p.rays = h.rays;
-  p.nonfinite = h.nonfinite;
-  p.seconds = h.seconds;
-  p.light_paths = h.light_paths;
-  size_t at = sizeof h;
-  extract(bytes, at, p.sum, n);
-  extract(bytes, at, p.lum2, n);
-  extract(bytes, at, p.samples, n);
-  if (h.has_caustics) extract(bytes, at, p.caustic_sum, n);
-  for (size_t i = 0; i < n; ++i)
-    if (p.samples[i] > p.count || !is_finite(p.sum[i]) || !std::isfinite(p.lum2[i]) ||
-        (h.has_caustics && !is_finite(p.caustic_sum[i])))
-      throw std::runtime_error("film pass: pixel " + std::to_string(i) + " holds impossible values");
-  return p;
+uint32_t Film::add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stopped) {
+  stopped = false;
+  if (!m_rule.enabled && from < to) {  // no stop test: only the last power of two in [from, to) is kept
+    const uint32_t last = 1u << (31 - __builtin_clz((to - 1) | 1));  // the largest power of two <= max(to - 1, 1)
+    if (to > 1 && last >= from) {
+      m_half_s1[i] = m_s1[i];
+      m_half_n[i] = last;
+    }
+    m_count[i] = to;
+    return to - from;
+  }
+  uint32_t s = from;
+  while (s < to) {
+    if (s > 0 && (s & (s - 1)) == 0) {
+      m_half_s1[i] = m_s1[i];
+      m_half_n[i] = s;
+    }
+    const uint32_t n = ++s;
+    if (m_rule.test_due(n) && m_rule.converged(m_s1[i], m_s2[i], n)) {
+      stopped = true;
+      break;
+    }
+  }
+  m_count[i] = s;
+  return s - from;
 }
 
-FilmPass render_film_pass(const RenderScene& scene, const RenderParams& params, uint32_t first, uint32_t count,
-                          const std::vector<uint8_t>& skip, const std::atomic<bool>* cancel, bool* complete) {
-  RenderParams p = params;
-  p.adaptive = false;  // convergence is judged on the merged statistics, not per pass
-  RenderSession session(scene, p);
-  session.set_sample_range(first, skip);
-  bool ok = session.render_pass(int(count), cancel);
-  if (complete) *complete = ok;
-  FilmPass out;
-  out.width = session.width();
-  out.height = session.height();
-  out.first = first;
-  out.count = count;
-  out.sum = session.pixel_sums();
-  out.lum2.assign(session.pixel_lum2_sums().begin(), session.pixel_lum2_sums().end());
-  out.samples = session.pixel_counts();
-  out.caustic_sum = session.caustic_sums();
-  SessionStats st = session.stats();
-  out.light_paths = st.light_paths;
-  out.rays = st.rays;
-  out.nonfinite = st.nonfinite;
-  out.seconds = st.seconds;
-  return out;
+void Film::skip(const std::vector<uint8_t>& skip) {
+  for (size_t i = 0; i < skip.size() && i < m_done.size(); ++i) m_done[i] |= skip[i];
 }
 
-FilmAccumulator::FilmAccumulator(const RenderParams& params, int width, int height)
-    : m_params(params), m_w(width), m_h(height) {
-  size_t n = size_t(width) * height;
-  m_sum.assign(n, Vec3(0.0f));
-  m_s1.assign(n, 0);
-  m_s2.assign(n, 0);
-  m_count.assign(n, 0);
-  m_half_s1.assign(n, 0);
-  m_half_n.assign(n, 0);
-  m_done.assign(n, 0);
-  m_remaining = n;
+bool Film::finished() const { return remaining() == 0; }
+
+size_t Film::remaining() const {
+  size_t n = 0;
+  for (uint8_t d : m_done) n += d == 0;
+  return n;
 }
 
-Vec3 FilmAccumulator::pixel_mean(size_t i) const {
-  return pixel_estimate(m_sum[i], m_count[i], m_lt_sum, m_lt_paths, i);
+double Film::progress() const {
+  double total = double(m_spp) * double(m_count.size()), done = 0;
+  for (size_t i = 0; i < m_count.size(); ++i) done += m_done[i] ? m_spp : std::min<uint32_t>(m_count[i], uint32_t(m_spp));
+  return total > 0 ? std::min(1.0, done / total) : 1.0;
 }
 
-void FilmAccumulator::merge(const FilmPass& pass) {
+void Film::begin_light_paths() {
+  if (m_lt_paths > 0 && m_lt_paths >= 2 * m_lt_half_paths) {
+    m_lt_half_s1 = m_lt_s1;
+    m_lt_half_paths = m_lt_paths;
+  }
+}
+
+void Film::add_splats(const std::vector<CausticSplat>& splats) {
+  for (const CausticSplat& s : splats) {
+    m_lt_sum[s.pixel] += s.value;
+    m_lt_s1[s.pixel] += luminance(s.value);
+  }
+}
+
+void Film::merge(const FilmPass& pass) {
   if (pass.width != m_w || pass.height != m_h) throw std::runtime_error("film pass of the wrong size");
   m_estimate.invalidate();
   uint64_t pass_samples = 0;
@@ -156,7 +139,6 @@ void FilmAccumulator::merge(const FilmPass& pass) {
     m_lt_paths += pass.light_paths;
     if (to_half) m_lt_half_paths += pass.light_paths;
   }
-  const int batch = std::max(1, m_params.adaptive_batch);
   for (size_t i = 0; i < m_sum.size(); ++i) {
     uint32_t c = pass.samples[i];
     if (c == 0) continue;
@@ -164,63 +146,183 @@ void FilmAccumulator::merge(const FilmPass& pass) {
     m_sum[i] += pass.sum[i];
     m_s1[i] += s1;
     m_s2[i] += pass.lum2[i];
-    uint32_t n = m_count[i] += c;
+    const uint32_t before = m_count[i], n = m_count[i] += c;
     if (to_half) {
       m_half_s1[i] += s1;
       m_half_n[i] += c;
     }
     if (m_done[i]) continue;
-    bool done = n >= uint32_t(m_params.spp);
-    // The course's test (95% confidence half-width within tolerance x mean), on merged sums.
-    if (!done && m_params.adaptive && n > uint32_t(batch))
-      done = confidence_reached(m_s1[i], m_s2[i], n, m_params.adaptive_tolerance);
-    if (done) {
+    if (n >= uint32_t(m_spp) || (m_rule.test_due_within(before, n) && m_rule.converged(m_s1[i], m_s2[i], n)))
       m_done[i] = 1;
-      --m_remaining;
-    }
   }
-  m_samples += pass_samples;
-  m_rays += pass.rays;
-  m_nonfinite += pass.nonfinite;
 }
 
-double FilmAccumulator::progress() const {
-  double total = double(m_params.spp) * m_w * m_h, done = 0;
-  for (size_t i = 0; i < m_count.size(); ++i) done += m_done[i] ? m_params.spp : std::min<uint32_t>(m_count[i], m_params.spp);
-  return total > 0 ? std::min(1.0, done / total) : 1.0;
+FilmPass Film::to_pass(uint32_t first, uint32_t count) const {
+  FilmPass out;
+  out.width = m_w;
+  out.height = m_h;
+  out.first = first;
+  out.count = count;
+  out.sum = m_sum;
+  out.lum2.assign(m_s2.begin(), m_s2.end());
+  out.samples = m_count;
+  out.caustic_sum = m_lt_sum;
+  out.light_paths = m_lt_paths;
+  return out;
 }
 
-double FilmAccumulator::error_estimate() const {
-  // As the session's, with the two halves made of whole passes.
-  return m_estimate.get([this] {
-    return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
-                                 {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths});
-  });
-}
-
-ImageRGB FilmAccumulator::image() const {
+ImageRGB Film::image() const {
   return make_image(m_w, m_h, [this](size_t i) { return pixel_mean(i); });
 }
 
-void FilmAccumulator::read_tile(const Tile& t, std::vector<Vec3>& out) const {
+ImageRGB Film::rate_image() const {
+  return make_image(m_w, m_h, [this](size_t i) { return rate_colour(m_count[i], m_spp); });
+}
+
+ImageRGB Film::caustic_image() const {
+  if (m_lt_paths == 0) return make_image(m_w, m_h, [](size_t) { return Vec3(0.0f); });
+  return make_image(m_w, m_h, [this](size_t i) { return m_lt_sum[i] / float(m_lt_paths); });
+}
+
+void Film::read_tile(const Tile& t, std::vector<Vec3>& out) const {
   out.clear();
   for (int y = t.y0; y < t.y1; ++y)
-    for (int x = t.x0; x < t.x1; ++x) {
-      out.push_back(pixel_mean(size_t(y) * m_w + x));
+    for (int x = t.x0; x < t.x1; ++x) out.push_back(pixel_mean(size_t(y) * m_w + x));
+}
+
+void Film::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const {
+  out.clear();
+  for (int y = t.y0; y < t.y1; ++y)
+    for (int x = t.x0; x < t.x1; ++x) out.push_back(rate_colour(m_count[size_t(y) * m_w + x], m_spp));
+}
+
+double Film::error_estimate(int threads) const {
+  return m_estimate.get([this, threads] {
+    return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
+                                 {&m_lt_s1, &m_lt_half_s1, m_lt_paths, m_lt_half_paths}, threads);
+  });
+}
+
+namespace {
+
+// A 3x3 neighbourhood's level, from its nine pixel means: the median, and the mean of the eight
+// below the largest (one firefly cannot lift it). The median by the 19 compare-exchanges of the
+// classic median-of-9 network (Paeth, Graphics Gems, 1990), branch-free.
+struct NeighbourhoodLevel {
+  double median, trimmed_mean;
+};
+inline NeighbourhoodLevel neighbourhood_level(const double in[9]) {
+  double v[9], sum = 0, top = in[0];
+#pragma GCC unroll 9
+  for (int k = 0; k < 9; ++k) v[k] = in[k], sum += in[k], top = std::max(top, in[k]);
+  auto sort2 = [&](int i, int j) {
+    double lo = std::min(v[i], v[j]), hi = std::max(v[i], v[j]);
+    v[i] = lo, v[j] = hi;
+  };
+  sort2(1, 2), sort2(4, 5), sort2(7, 8), sort2(0, 1), sort2(3, 4), sort2(6, 7), sort2(1, 2), sort2(4, 5);
+  sort2(7, 8), sort2(0, 3), sort2(5, 8), sort2(4, 7), sort2(3, 6), sort2(1, 4), sort2(2, 5), sort2(4, 7);
+  sort2(4, 2), sort2(6, 4), sort2(4, 2);
+  return {v[4], (sum - top) / 8};
+}
+
+}  // namespace
+
+double halves_error_estimate(int width, const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
+                             const std::vector<double>& s1, const std::vector<double>& half_s1,
+                             const SplatStats& splats, int threads) {
+  // Relative MSE of the pixel means: mean over pixels of Var[mean] / (mu^2 + eps) (relMSE as in
+  // Rousselle et al. 2011, eps keeping black pixels finite). Var[mean] comes from comparing the
+  // mean A of samples [0, P) with the mean B of [P, n):
+  // E[(A - B)^2] P (n - P) / n^2 = sigma^2 / n for independent samples, and unlike the sample
+  // variance it also sees the faster convergence of stratified (Sobol) samples, each half of
+  // which is itself well stratified.
+  // mu stands for the pixel's true mean, which the true relMSE divides by. The pixel's own mean is
+  // a poor stand-in both ways (docs/performance.md, "Error estimate"):
+  // - above its neighbourhood, a mean lifted by one half's rare bright sample divides its own
+  //   error away (CBspheres at m = 100 fell to 0.6 of the truth): mu is at most the larger of the
+  //   neighbourhood's median and the smaller half's mean;
+  // - a small, noisy mean of few samples inflates the ratio (E[1/mu^2] > 1/E[mu]^2: CBdragon 7x
+  //   the truth at 2 spp): mu is lifted towards the neighbourhood's level, its mean without its
+  //   largest value, but no further than one standard error above the pixel's own mean, so a
+  //   pixel that is surely darker than its neighbours (an edge) keeps its own mean, and the lift
+  //   fades as samples accumulate.
+  // It runs between passes, in blocks of rows on the render's threads; each block keeps its rows'
+  // means (and the rows on either side) in a buffer, and the blocks' sums are added in block order,
+  // so the estimate does not depend on the thread count.
+  const size_t n_pixels = count.size();
+  const bool with_splats = splats.n > 0;
+  const double splat_n = double(splats.n);
+  auto mean_at = [&](size_t i) {
+    double m = count[i] ? s1[i] / count[i] : 0.0;
+    if (with_splats) m += (*splats.s1)[i] / splat_n;
+    return m;
+  };
+  // A film that is not width x rows (none is, but the caller passes width and pixels apart) is
+  // read as one row.
+  size_t w = size_t(std::max(1, width)), h = n_pixels / w;
+  if (w * h != n_pixels) w = std::max<size_t>(1, n_pixels), h = n_pixels ? 1 : 0;
+  auto block = [&](size_t y0, size_t y1, double& block_sum, size_t& block_used) {
+    double sum = 0;
+    size_t used = 0;
+    const size_t r0 = y0 > 0 ? y0 - 1 : 0, r1 = std::min(h, y1 + 1);  // rows kept: y0 - 1 .. y1
+    std::vector<double> means((r1 - r0) * w);
+    for (size_t y = r0; y < r1; ++y)
+      for (size_t x = 0; x < w; ++x) means[(y - r0) * w + x] = mean_at(y * w + x);
+    for (size_t y = y0; y < y1; ++y) {
+      const double* rows[3] = {&means[((y > 0 ? y - 1 : y) - r0) * w], &means[(y - r0) * w],
+                               &means[((y + 1 < h ? y + 1 : y) - r0) * w]};  // edges repeat
+      for (size_t x = 0; x < w; ++x) {
+        const size_t i = y * w + x;
+        uint32_t n = count[i], p = half_n[i];
+        if (n < 2 || p == 0 || p >= n) continue;
+        ++used;
+        if (s1[i] == 0 && half_s1[i] == 0 && !with_splats) continue;  // a black pixel adds exactly 0
+        double a = half_s1[i] / p, b = (s1[i] - half_s1[i]) / (n - p);
+        double var_mean = (a - b) * (a - b) * double(p) * double(n - p) / (double(n) * n);
+        if (with_splats) {
+          double sp = double(splats.half_n), t1 = (*splats.s1)[i];
+          if (sp > 0 && sp < splat_n) {
+            double sa = (*splats.half_s1)[i] / sp, sb = (t1 - (*splats.half_s1)[i]) / (splat_n - sp);
+            var_mean += (sa - sb) * (sa - sb) * sp * (splat_n - sp) / (splat_n * splat_n);
+          }
+        }
+        const size_t xl = x > 0 ? x - 1 : x, xr = x + 1 < w ? x + 1 : x;
+        const double v[9] = {rows[0][xl], rows[0][x], rows[0][xr], rows[1][xl], rows[1][x],
+                             rows[1][xr], rows[2][xl], rows[2][x], rows[2][xr]};
+        const double own = v[4];
+        const NeighbourhoodLevel level = neighbourhood_level(v);
+        double mu = std::min(own, std::max(level.median, std::min(a, b)));
+        mu = std::max(mu, std::min(level.trimmed_mean, own + std::sqrt(var_mean)));
+        sum += var_mean / (mu * mu + kRelMseEpsilon);
+      }
     }
+    block_sum = sum, block_used = used;
+  };
+  const size_t rows_per_block = std::max<size_t>(1, (size_t(1) << 14) / w);  // starting a thread costs about what a few thousand pixels do
+  const size_t blocks = (h + rows_per_block - 1) / rows_per_block;
+  std::vector<double> sums(blocks, 0.0);
+  std::vector<size_t> useds(blocks, 0);
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t b; (b = next.fetch_add(1)) < blocks;)
+      block(b * rows_per_block, std::min(h, (b + 1) * rows_per_block), sums[b], useds[b]);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::min<int>(threads, int(blocks)); ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  double sum = 0;
+  size_t used = 0;
+  for (size_t b = 0; b < blocks; ++b) sum += sums[b], used += useds[b];
+  return used ? sum / double(n_pixels) : INFINITY;
 }
 
-std::string pack_mask(const std::vector<uint8_t>& mask) {
-  std::string bits((mask.size() + 7) / 8, '\0');
-  for (size_t i = 0; i < mask.size(); ++i)
-    if (mask[i]) bits[i / 8] = char(uint8_t(bits[i / 8]) | (1u << (i % 8)));
-  return bits;
+std::string format_error_estimate(double error) {
+  if (!std::isfinite(error)) return "n/a";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", error);
+  return buf;
 }
 
-std::vector<uint8_t> unpack_mask(const std::string& bits, size_t pixels) {
-  std::vector<uint8_t> mask(pixels, 0);
-  for (size_t i = 0; i < pixels && i / 8 < bits.size(); ++i) mask[i] = (uint8_t(bits[i / 8]) >> (i % 8)) & 1;
-  return mask;
-}
 
 }  // namespace pt

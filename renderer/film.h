@@ -1,90 +1,201 @@
-// Sample passes that render on different machines and merge exactly. A pass is the whole frame
-// rendered for sample indices [first, first + count) of every pixel not yet converged; since each
-// sample's random numbers depend only on (seed, pixel, index), merging the per-pixel sums and
-// counts of disjoint passes gives the image one machine would have made.
+// The film: per-pixel statistics of a render, the one adaptive stop rule, the error estimate, and
+// merging. The session adds samples to it one by one; the scale-out's server merges workers'
+// passes into it (FilmPass, film_pass.h). Both read images, tiles and the estimate from here.
 #pragma once
 
-#include <atomic>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include "image.h"
-#include "render.h"
+#include "math.h"
 
 namespace pt {
 
-struct FilmPass {
-  int width = 0, height = 0;
-  uint32_t first = 0, count = 0;   // the sample-index range asked for
-  std::vector<Vec3> sum;           // radiance sums per pixel
-  std::vector<float> lum2;         // luminance-squared sums (adaptive sampling's variance)
-  std::vector<uint32_t> samples;   // samples taken per pixel (0 for skipped pixels)
-  // Light-traced caustics (caustics.h): splat sums per pixel over `light_paths` paths, the pass's
-  // share of them; empty when the job renders caustics by path tracing alone.
-  std::vector<Vec3> caustic_sum;
-  uint64_t light_paths = 0;
-  uint64_t rays = 0, nonfinite = 0;
-  double seconds = 0;
+struct FilmPass;
+struct CausticSplat;
 
-  // A compact little-endian encoding for the wire, and its strict inverse: decode throws
-  // std::runtime_error saying what is wrong with a short, oversized or inconsistent buffer.
-  std::string encode() const;
-  static FilmPass decode(const std::string& bytes, int expect_width, int expect_height);
+struct Tile {
+  int x0, y0, x1, y1;  // film pixels, top-left origin, half-open
 };
 
-// Renders one pass. `skip` (one byte per pixel, may be empty) marks converged pixels; `cancel`
-// stops early (the pass then holds what was done and comes back marked incomplete).
-FilmPass render_film_pass(const RenderScene& scene, const RenderParams& params, uint32_t first, uint32_t count,
-                          const std::vector<uint8_t>& skip, const std::atomic<bool>* cancel, bool* complete = nullptr);
+// The course's adaptive sampling (../shared/notes/cs184-spec.md): a pixel is tested after sample n
+// when n > 1 and n - 1 is a multiple of the batch, and stops once the 95% confidence half-width of
+// its luminance is within tolerance x mean. Where samples arrive in blocks (merged passes), a
+// block that crosses a test count is tested at its end.
+struct AdaptiveRule {
+  bool enabled = true;
+  uint32_t batch = 32;
+  double tolerance = 0.05;
 
-// The merged image: what the server keeps while passes arrive from workers. Mirrors the session's
-// statistics (mean, adaptive test, error estimate) over merged sums.
-class FilmAccumulator {
+  bool test_due(uint32_t n) const { return enabled && n > 1 && (n - 1) % batch == 0; }
+  // The first count after c at which a test is due.
+  uint32_t next_test(uint32_t c) const { return 1 + batch * ((std::max(c, 1u) + batch - 1) / batch); }
+  bool test_due_within(uint32_t before, uint32_t after) const { return enabled && next_test(before) <= after; }
+  // The test itself, for n > 1 luminance samples of sum s1 and sum of squares s2.
+  bool converged(double s1, double s2, uint32_t n) const {
+    double mu = s1 / n;
+    double var = std::max(0.0, (s2 - s1 * s1 / n) / (n - 1));
+    return 1.96 * std::sqrt(var / n) <= tolerance * mu;
+  }
+};
+
+// The last error estimate of statistics that have not changed since. A render's callers ask
+// again after its last pass (the CLI's summary line and EXR header, the job's final report), and
+// each estimate reads every pixel's statistics and its neighbours'. Whoever changes the
+// statistics calls invalidate(); get() is safe from several threads at once.
+class CachedEstimate {
  public:
-  FilmAccumulator(const RenderParams& params, int width, int height);
-
-  void merge(const FilmPass& pass);
-  int width() const { return m_w; }
-  int height() const { return m_h; }
-  // Pixels that need no more samples: the sample budget is spent or, with adaptive sampling, the
-  // course's confidence test passed on the merged statistics.
-  const std::vector<uint8_t>& done() const { return m_done; }
-  bool finished() const { return m_remaining == 0; }
-  size_t remaining() const { return m_remaining; }  // pixels still taking samples
-  double progress() const;
-  double error_estimate() const;  // computed once after each merge
-  uint64_t samples() const { return m_samples; }
-  uint64_t rays() const { return m_rays; }
-  uint64_t nonfinite() const { return m_nonfinite; }
-  uint64_t light_paths() const { return m_lt_paths; }  // caustic light paths merged
-  ImageRGB image() const;
-  void read_tile(const Tile& t, std::vector<Vec3>& out) const;
+  CachedEstimate() = default;
+  // A copy starts empty (its owner's statistics are copied beside it; the next get() computes).
+  CachedEstimate(const CachedEstimate&) {}
+  CachedEstimate& operator=(const CachedEstimate&) {
+    invalidate();
+    return *this;
+  }
+  void invalidate() {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_valid = false;
+  }
+  template <class Compute>
+  double get(Compute compute) const {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    if (!m_valid) {
+      m_value = compute();
+      m_valid = true;
+      ++m_computed;
+    }
+    return m_value;
+  }
+  uint64_t times_computed() const {  // for tests: each estimate is paid once
+    std::lock_guard<std::mutex> lock(m_mutex);
+    return m_computed;
+  }
 
  private:
-  RenderParams m_params;
-  int m_w, m_h;
+  mutable std::mutex m_mutex;
+  mutable bool m_valid = false;
+  mutable double m_value = 0;
+  mutable uint64_t m_computed = 0;
+};
+
+// Light-traced splats' share of the error estimate: per-pixel splat luminance sums of n light
+// paths and of a first part half_n of them.
+struct SplatStats {
+  const std::vector<double>* s1 = nullptr;
+  const std::vector<double>* half_s1 = nullptr;
+  uint64_t n = 0, half_n = 0;
+};
+// Relative MSE of the pixel means without a reference, from per-pixel sample counts, luminance
+// sums, and the count and sum of a part of each pixel's samples, on a film `width` pixels wide
+// (row-major); infinite until some pixel has two parts to compare. See film.cpp.
+double halves_error_estimate(int width, const std::vector<uint32_t>& count, const std::vector<uint32_t>& half_n,
+                             const std::vector<double>& s1, const std::vector<double>& half_s1,
+                             const SplatStats& splats = {}, int threads = 1);
+// An error estimate as the CLI's summary and the window show it: "%.3g", or "n/a" while it is
+// infinite (before any pixel has two samples). The CSV log keeps "inf", which parsers read.
+std::string format_error_estimate(double error);
+
+class Film {
+ public:
+  // A width x height film for `spp` samples a pixel; `caustics`: it also sums light-traced splats.
+  Film(int width, int height, int spp, const AdaptiveRule& rule, bool caustics);
+
+  int width() const { return m_w; }
+  int height() const { return m_h; }
+  size_t pixels() const { return m_count.size(); }
+  int spp() const { return m_spp; }
+  const AdaptiveRule& rule() const { return m_rule; }
+
+  // ---- one sample at a time (the session's tiles; each pixel belongs to one thread) ----
+  // Adds sample s (the pixel's count so far) of pixel i; true when the adaptive rule stops the pixel
+  // there. A non-finite sample counts as black and in `nonfinite`.
+  bool add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& nonfinite) {
+    if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
+      ++nonfinite;
+      l = Vec3(0.0f);
+    }
+    if (s > 0 && (s & (s - 1)) == 0) {  // s samples so far, a power of two: keep their sum
+      m_half_s1[i] = m_s1[i];
+      m_half_n[i] = s;
+    }
+    m_sum[i] += l;
+    double lum = luminance(l);
+    m_s1[i] += lum;
+    m_s2[i] += lum * lum;
+    uint32_t n = ++m_count[i];
+    return m_rule.test_due(n) && m_rule.converged(m_s1[i], m_s2[i], n);
+  }
+  // Black samples [from, to) of pixel i (it sees only background): add_sample with l = 0 for each.
+  // Stops after the first adaptive test that passes (then `stopped`); returns the samples added.
+  uint32_t add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stopped);
+  uint32_t count(size_t i) const { return m_count[i]; }
+  bool done(size_t i) const { return m_done[i] != 0; }
+  void set_done(size_t i) { m_done[i] = 1; }
+  const std::vector<uint8_t>& done_mask() const { return m_done; }
+  // Marks pixels whose `skip` byte is set as done (a share of a distributed render leaves them out).
+  void skip(const std::vector<uint8_t>& skip);
+  bool finished() const;     // every pixel done
+  size_t remaining() const;  // pixels still taking samples
+  // Fraction of the sample budget done, converged pixels counted in full.
+  double progress() const;
+
+  // ---- light-traced caustics (caustics.h) ----
+  bool has_caustics() const { return !m_lt_sum.empty(); }
+  // Before a pass's light paths: the error estimate's first part becomes the paths so far once
+  // they are at least twice those of the last part (as add_sample's powers of two).
+  void begin_light_paths();
+  void add_splats(const std::vector<CausticSplat>& splats);
+  void add_light_paths(uint64_t n) { m_lt_paths += n; }
+  uint64_t light_paths() const { return m_lt_paths; }
+
+  // ---- whole passes ----
+  // Adds a pass of the same size (throws std::runtime_error otherwise). The error estimate's two
+  // parts are made of whole passes, each pass going to the smaller part; the adaptive rule tests a
+  // pixel whose pass crossed a test count.
+  void merge(const FilmPass& pass);
+  // The film's sums for sample range [first, first + count), as a worker sends them.
+  FilmPass to_pass(uint32_t first, uint32_t count) const;
+
+  // ---- reading ----
+  // A pixel's radiance: the mean of its camera samples plus its splat sum over every light path.
+  Vec3 pixel_mean(size_t i) const {
+    Vec3 v = m_count[i] ? m_sum[i] / float(m_count[i]) : Vec3(0.0f);
+    if (m_lt_paths > 0) v += m_lt_sum[i] / float(m_lt_paths);
+    return v;
+  }
+  ImageRGB image() const;
+  ImageRGB rate_image() const;     // the course's sample-rate colouring
+  ImageRGB caustic_image() const;  // the light-traced caustics alone; black without them
+  // Mean radiance / rate colours of a tile's pixels, row by row. Safe while other tiles render.
+  void read_tile(const Tile& t, std::vector<Vec3>& out) const;
+  void read_tile_rate(const Tile& t, std::vector<Vec3>& out) const;
+  // Estimated relative MSE of image() (halves_error_estimate), computed once for each state of the
+  // statistics; call invalidate_estimate() after changing them.
+  double error_estimate(int threads = 1) const;
+  void invalidate_estimate() { m_estimate.invalidate(); }
+  uint64_t error_estimates_computed() const { return m_estimate.times_computed(); }
+
+ private:
+  int m_w, m_h, m_spp;
+  AdaptiveRule m_rule;
   std::vector<Vec3> m_sum;
-  std::vector<double> m_s1, m_s2;
-  std::vector<uint32_t> m_count;
-  // Passes alternate between two halves (by samples so far); the error estimate compares the
-  // halves' means, as the session compares its power-of-two halves.
+  std::vector<double> m_s1, m_s2;  // luminance sums and sums of squares
+  // The part of each pixel's samples the error estimate compares with the rest: added one by one,
+  // those up to the last power of two below the count; merged, whole passes.
   std::vector<double> m_half_s1;
   std::vector<uint32_t> m_half_n;
-  uint64_t m_half_samples = 0, m_other_samples = 0;
+  std::vector<uint32_t> m_count;
   std::vector<uint8_t> m_done;
-  size_t m_remaining;
-  // Caustic splat sums and their luminance, split into the same halves as the camera samples.
+  uint64_t m_half_samples = 0, m_other_samples = 0;  // merged passes' samples in either part
+  // Caustic splat sums over m_lt_paths light paths, their luminance, and the first part's.
   std::vector<Vec3> m_lt_sum;
   std::vector<double> m_lt_s1, m_lt_half_s1;
   uint64_t m_lt_paths = 0, m_lt_half_paths = 0;
-  CachedEstimate m_estimate;  // error_estimate() of what was merged so far
-  Vec3 pixel_mean(size_t i) const;
-  uint64_t m_samples = 0, m_rays = 0, m_nonfinite = 0;
+  CachedEstimate m_estimate;
 };
-
-// One byte per pixel <-> one bit per pixel, for sending the converged mask with each pass.
-std::string pack_mask(const std::vector<uint8_t>& mask);
-std::vector<uint8_t> unpack_mask(const std::string& bits, size_t pixels);
 
 }  // namespace pt

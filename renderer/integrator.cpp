@@ -8,7 +8,7 @@
 
 #include "diffuse_lanes.h"
 #include "materials.h"
-#include "render.h"
+#include "integrator.h"
 #include "sampler.h"
 
 namespace pt {

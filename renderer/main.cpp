@@ -12,7 +12,7 @@
 #include "collada.h"
 #include "diffuse_lanes.h"
 #include "progress.h"
-#include "render.h"
+#include "session.h"
 #include "viewer.h"
 
 using namespace pt;

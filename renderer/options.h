@@ -1,16 +1,55 @@
-// The one table of render options: name, type, range, the course's default (the CLI's) and the job
-// service's, help, and where each lives in RenderParams / RunLimits. From it come the CLI's value
+// The render options (RenderParams, RunLimits) and the one table that describes them: name, type,
+// range, the course's default (the CLI's) and the job service's, help, and where each lives. From it come the CLI's value
 // ranges, RenderParams::validate, the job service's JSON fields (names, defaults, ranges), the
 // render metadata keys; tests/test_options.cpp checks the OpenAPI document's job fields against it.
 // The job service may narrow a range by policy (server/job_spec.h, SpecLimits), never widen it.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
-#include "render.h"
+#include "sampler.h"
 
 namespace pt {
+
+struct RenderParams {
+  int spp = 1;                     // -s: camera rays per pixel
+  int light_samples = 1;           // -l: samples per area / environment / ambient light
+  int max_depth = 1;               // -m: maximum ray depth (bounces; each specular event uses one)
+  int threads = 1;                 // -t
+  float lens_radius = 0;           // -b (the course calls it aperture)
+  float focal_distance = 4.7f;     // -d
+  int width = 800, height = 600;   // -r
+  bool adaptive = true;            // -a: on by default, as in the course
+  int adaptive_batch = 32;
+  float adaptive_tolerance = 0.05f;
+  bool hemisphere = false;         // -H: uniform hemisphere direct lighting
+  std::string env_map;             // -e: lat-long OpenEXR environment
+  std::string camera_file;         // -c
+  bool file_camera = false;        // --file-camera: the scene's camera as authored
+  bool keep_fov = false;           // --keep-fov: -r scales the course's view instead of cropping it
+  int cell_x = 0, cell_y = 0, cell_w = 0, cell_h = 0;  // -p: window, bottom-left origin; w = 0: full frame
+  uint64_t seed = 0;               // --seed
+  int tile_size = 32;
+  bool generic = false;            // --generic: the path loop with every feature (for comparisons)
+  bool ray_packets = true;         // --no-ray-packets: trace paths one at a time, not in Embree packets
+  bool simd_lanes = true;          // --no-simd-lanes: packets' diffuse vertices and sample draws one at a time
+  SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
+  bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
+  // Set by RenderSession, not by users: its light tracer renders the caustic paths (caustics.h),
+  // so the path loop leaves them out.
+  bool caustics_light_traced = false;
+
+  // Throws std::invalid_argument naming the field when a value is out of range.
+  void validate() const;
+};
+
+// Halting conditions shared by the CLI, the server and the window.
+struct RunLimits {
+  double time_limit = 0;     // seconds of rendering; 0 = none
+  double target_error = 0;   // stop once error_estimate() <= this; 0 = none
+};
 
 enum class OptionType {
   integer,  // a whole number

@@ -10,7 +10,7 @@
 
 #include "materials.h"
 #include "options.h"
-#include "render.h"
+#include "render_scene.h"
 
 namespace pt {
 
@@ -261,6 +261,12 @@ std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams
 std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
   params.validate();  // before the build: a bad option fails fast
   return view_of(make_scene_base(desc), params);
+}
+
+float autofocus_distance(const RenderScene& scene, float sx, float sy) {
+  Ray r = scene.camera.pinhole_ray(sx, sy);
+  SurfaceHit hit;
+  return scene.accel->intersect(r, hit) ? hit.t : kInf;
 }
 
 }  // namespace pt

@@ -20,7 +20,7 @@
 #include <thread>
 
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 #include "viewer_loop.h"
 
 namespace pt {

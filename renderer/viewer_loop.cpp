@@ -77,37 +77,39 @@ void RenderLoop::loop() {
     lk.unlock();
     uint64_t gen = m_gen;
     RenderSession* s = m_session.get();
-    bool ok = s->render_pass(m_target, &m_sh.cancel, [this, gen, s](const Tile& t) { send_tile(gen, *s, t); });
-    if (ok) {
-      // --target-error ends the window's render as it ends a file render (run_progressive), with
-      // the same pass sizes towards it.
-      const double target_error = m_options.limits.target_error;
+    const PassReport r = m_driver->step(&m_sh.cancel, [this, gen, s](const Tile& t) { send_tile(gen, *s, t); });
+    // A pass cut short by a cancel is resumed by the next step; one cut short by --time-limit ends
+    // the render, as the error target and the sample budget do (the driver decides all three).
+    const bool reported = r.completed || m_driver->done();
+    if (reported) {
       Status st = m_status;
-      st.reached_spp = m_target;
-      st.error = s->error_estimate();
-      const bool on_target = target_error > 0 && st.error <= target_error;
-      st.finished = m_target >= m_params.spp || s->finished() || on_target;
-      st.seconds = s->stats().seconds;
+      if (r.completed) st.reached_spp = r.target_spp;
+      st.error = r.error;
+      st.finished = m_driver->done();
+      st.seconds = r.seconds;
       m_status = st;
       m_done = st.finished;
+      const StopReason why = m_driver->reason();
       if (!m_options.quiet)
         say("pass: %d/%d spp, error estimate %s, %.2f s%s", st.reached_spp, st.spp,
-            format_error_estimate(st.error).c_str(), st.seconds, on_target ? ", error target reached" : "");
-      m_target = next_pass_target(m_target, m_params.spp, st.error, target_error);
+            format_error_estimate(st.error).c_str(), st.seconds,
+            m_done && why != StopReason::finished ? (std::string(", ") + stop_reason_name(why)).c_str() : "");
     }
     lk.lock();
-    if (ok) m_sh.status = m_status;
+    if (reported) m_sh.status = m_status;
     m_sh.wake_window();
   }
 }
 
 void RenderLoop::start_session(const RenderParams& p, uint64_t gen) {
+  m_driver.reset();
   m_session.reset();
   m_scene.camera = make_camera(m_desc, camera_params(p));
+  m_driver.reset();
   m_session = std::make_unique<RenderSession>(m_scene, p);
+  m_driver = std::make_unique<ProgressiveDriver>(*m_session, m_options.limits);
   m_params = p;
   m_gen = gen;
-  m_target = 1;
   m_done = false;
   m_status = Status{};
   m_status.gen = gen;
@@ -121,11 +123,11 @@ void RenderLoop::start_session(const RenderParams& p, uint64_t gen) {
 void RenderLoop::send_tile(uint64_t gen, const RenderSession& s, const Tile& t) {
   TileUpdate u{gen, t, {}, {}};
   std::vector<Vec3> px;
-  s.read_tile(t, px);
+  s.film().read_tile(t, px);
   u.rgb.resize(px.size() * 3);
   for (size_t i = 0; i < px.size(); ++i)
     for (int c = 0; c < 3; ++c) u.rgb[3 * i + c] = tonemap_course(px[i][c]);
-  s.read_tile_rate(t, px);
+  s.film().read_tile_rate(t, px);
   u.rate.resize(px.size() * 3);
   for (size_t i = 0; i < px.size(); ++i)
     for (int c = 0; c < 3; ++c) u.rate[3 * i + c] = tonemap_course(px[i][c]);  // as the _rate.png

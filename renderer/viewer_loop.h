@@ -1,7 +1,8 @@
-// The debug window's render thread (viewer.cpp runs the window): it runs RenderSession passes of
-// doubling sample targets for the settings the window asks for, hands finished tiles (tone-mapped
-// as the PNG is) to the window thread, and runs its focus and save commands between passes. No
-// GLFW here: it wakes the window through Shared::wake_window.
+// The debug window's render thread (viewer.cpp runs the window): it steps the progressive driver
+// (driver.h: pass sizes, --target-error, --time-limit) over a session for the settings the window
+// asks for, hands finished tiles (tone-mapped as the PNG is) to the window thread, and runs its
+// focus and save commands between passes. No GLFW here: it wakes the window through
+// Shared::wake_window.
 #pragma once
 
 #include <atomic>
@@ -16,7 +17,7 @@
 #include <vector>
 
 #include "cli.h"
-#include "render.h"
+#include "session.h"
 
 namespace pt {
 namespace viewer {
@@ -98,9 +99,9 @@ class RenderLoop {
   RenderScene& m_scene;  // its camera is rebuilt for each session; only this thread touches it
   Shared& m_sh;
   std::unique_ptr<RenderSession> m_session;
+  std::unique_ptr<ProgressiveDriver> m_driver;  // the session's passes and stop rules
   RenderParams m_params;
   uint64_t m_gen = 0;
-  int m_target = 1;
   bool m_done = false;
   Status m_status;
 };

@@ -26,7 +26,7 @@ class EmbeddedBackend : public RenderBackend {
 
     auto on_tile = [&](const pt::Tile& t) {
       thread_local std::vector<pt::Vec3> buf;
-      session.read_tile(t, buf);
+      session.film().read_tile(t, buf);
       sink.tile(t, buf);
     };
     auto report = [&](double error) {

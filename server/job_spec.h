@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "options.h"
-#include "render.h"
+#include "render_scene.h"
+#include "render_scene.h"
 
 namespace srv {
 

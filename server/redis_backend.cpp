@@ -1,15 +1,16 @@
 // The Redis backend: a job becomes sample passes on the stream pt:work; render-workers render them
 // and return per-pixel sums on the run's results stream, which are merged here as they arrive
-// (pt::FilmAccumulator) and stream to the page like the embedded renderer's tiles.
+// (pt::Film) and stream to the page like the embedded renderer's tiles.
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <mutex>
 #include <random>
 #include <set>
 
 #include "collada.h"
-#include "film.h"
+#include "film_pass.h"
 #include "jobs.h"
 #include "redis_queue.h"
 #include "render_backend.h"
@@ -99,6 +100,178 @@ std::vector<std::string> parse_features(const std::string* text) {
   return out;
 }
 
+// A job's passes, rendered by workers and merged here as they arrive: the PassSource the driver
+// runs for this backend. PassPlan sizes the passes by the workers' speed (the driver's targets do
+// not apply: a target is a whole frame's pass, and workers render many at once), and each
+// advance() returns once something was merged.
+class WorkerPasses : public pt::PassSource {
+ public:
+  WorkerPasses(const Job& job, const std::string& scene_text, RedisClient& redis, JobSink& sink,
+               std::function<int()> live_workers, int in_flight)
+      : m_job(job), m_params(job.spec.params), m_scene_text(scene_text), m_redis(redis), m_sink(sink),
+        m_live_workers(std::move(live_workers)), m_in_flight(in_flight),
+        m_w(m_params.cell_w > 0 ? m_params.cell_w : m_params.width),
+        m_h(m_params.cell_w > 0 ? m_params.cell_h : m_params.height),
+        m_run(new_run_id()), m_job_key(rq::job_key(job.id, m_run)), m_results(rq::results_key(job.id, m_run)),
+        m_scene_hash(rq::content_hash(scene_text)), m_spec_json(job_spec_to_json(job.spec).dump()),
+        // the scene decides whether passes carry caustics; plan for the larger
+        m_plan(m_params.spp, size_t(m_w) * m_h, m_params.caustic_tracing ? 32.0 : 20.0),
+        m_film(m_w, m_h, m_params.spp, pt::adaptive_rule(m_params), false) {
+    const int ts = m_params.tile_size;
+    for (int y = 0; y < m_h; y += ts)
+      for (int x = 0; x < m_w; x += ts) m_tiles.push_back({x, y, std::min(x + ts, m_w), std::min(y + ts, m_h)});
+  }
+  // However the render ends, workers learn the run is over.
+  ~WorkerPasses() override {
+    try {
+      m_redis.set_patience(0);
+      m_redis.command({"DEL", m_job_key, m_results});
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "render-server: cannot clean up %s: %s\n", m_job_key.c_str(), e.what());
+    }
+  }
+
+  bool advance(int, const std::atomic<bool>* cancel, const pt::TileCallback& on_tile) override;
+  void set_deadline(std::chrono::steady_clock::time_point t) override { m_deadline = t; }
+  const pt::Film& film() const override { return m_film; }
+  double seconds() const override { return std::chrono::duration<double>(clock::now() - m_t0).count(); }
+  bool finished() const override {
+    return m_film.finished() || (m_plan.exhausted() && m_merged.size() == m_plan.issued());
+  }
+  RenderReport report(double error) const { return {m_film.progress(), m_samples, m_rays, m_nonfinite, error}; }
+  // After the last advance: the sink has started, and the log has the job's merge costs.
+  void finish(pt::StopReason why);
+
+ private:
+  using clock = std::chrono::steady_clock;
+  void issue(size_t unit);
+  void publish();
+  bool merge(const RedisReply& r);  // true when a pass was merged
+
+  const Job& m_job;
+  const pt::RenderParams& m_params;
+  const std::string& m_scene_text;
+  RedisClient& m_redis;
+  JobSink& m_sink;
+  std::function<int()> m_live_workers;
+  int m_in_flight;
+  int m_w, m_h;
+  std::string m_run, m_job_key, m_results, m_scene_hash, m_spec_json;
+  PassPlan m_plan;
+  pt::Film m_film;
+  std::vector<pt::Tile> m_tiles;
+  std::set<uint32_t> m_merged;
+  std::string m_last_id = "0-0";
+  uint64_t m_published = ~uint64_t(0);  // the connection the run was last published on (none yet)
+  int m_workers = 1;
+  clock::time_point m_next_worker_count = clock::now(), m_t0 = clock::now();
+  clock::time_point m_deadline = clock::time_point::max();
+  bool m_started = false;
+  double m_merge_seconds = 0;  // decoding, merging and publishing passes: the server's cost per pass
+  size_t m_pass_bytes = 0;
+  uint64_t m_samples = 0, m_rays = 0, m_nonfinite = 0;
+};
+
+void WorkerPasses::issue(size_t unit) {
+  auto [first, count] = m_plan.range(unit);
+  m_redis.command({"XADD", rq::kWorkStream, "*", "job", m_job.id, "run", m_run, "unit", std::to_string(unit), "first",
+                   std::to_string(first), "count", std::to_string(count), "mask",
+                   m_params.adaptive ? pt::pack_mask(m_film.done_mask()) : std::string()});
+}
+
+// Puts what workers need in Redis: the group, the scene's bytes (once per content: repeated jobs on
+// a large scene send only its hash), the run's hash. Again on every new connection: a Redis
+// restarted without its data has lost them, and the passes issued so far, which go out again (a
+// pass rendered twice is merged once).
+void WorkerPasses::publish() {
+  const std::string ttl = std::to_string(rq::kKeyTtlSeconds);
+  do {
+    m_redis.command({"PING"});
+    m_published = m_redis.connections();
+    rq::ensure_group(m_redis);
+    m_redis.command({"SET", rq::scene_key(m_scene_hash), m_scene_text, "EX", ttl, "NX"});
+    m_redis.command({"EXPIRE", rq::scene_key(m_scene_hash), ttl});
+    bool fresh = m_redis.command({"HSET", m_job_key, "spec", m_spec_json, "scene", m_scene_hash}).integer_value > 0;
+    m_redis.command({"EXPIRE", m_job_key, ttl});
+    if (fresh && m_plan.issued() > m_merged.size()) {
+      std::fprintf(stderr, "render-server: job %s: the run's keys were gone from Redis; issuing its %zu unmerged passes again\n",
+                   m_job.id.c_str(), m_plan.issued() - m_merged.size());
+      for (size_t u = 0; u < m_plan.issued(); ++u)
+        if (!m_merged.count(uint32_t(u))) issue(u);
+    }
+    if (fresh) m_last_id = "0-0";  // results of the lost stream that came in again
+  } while (m_redis.connections() != m_published);
+}
+
+bool WorkerPasses::merge(const RedisReply& r) {
+  // Everything read from Redis is checked: [[stream, [[id, [field, value, ...]], ...]]].
+  if (r.type != RedisReply::array || r.elements.empty() || r.elements[0].elements.size() < 2) return false;
+  bool changed = false;
+  for (const RedisReply& e : r.elements[0].elements[1].elements) {
+    if (e.elements.size() != 2 || e.elements[0].type != RedisReply::string) continue;
+    m_last_id = e.elements[0].str;
+    const RedisReply& body = e.elements[1];
+    if (const std::string* err = body.field("error")) throw std::runtime_error(valid_utf8(*err, 2000));
+    const std::string* bytes = body.field("pass");
+    uint32_t u = 0;
+    if (!rq::parse_u32(body.field("unit"), u) || !bytes) continue;
+    if (u >= m_plan.issued() || m_merged.count(u)) continue;  // a pass rendered twice (its first worker looked dead)
+    pt::FilmPass pass = pt::FilmPass::decode(*bytes, m_w, m_h);
+    m_pass_bytes += bytes->size();
+    if (pass.first != m_plan.range(u).first || pass.count != m_plan.range(u).second) continue;
+    uint64_t pass_samples = 0;
+    for (uint32_t n : pass.samples) pass_samples += n;
+    m_plan.observe(pass_samples, pass.seconds);
+    if (!m_started) {
+      m_sink.started(m_w, m_h, parse_features(body.field("features")));
+      m_started = true;
+    }
+    m_film.merge(pass);
+    m_merged.insert(u);
+    m_samples += pass_samples;
+    m_rays += pass.rays;
+    m_nonfinite += pass.nonfinite;
+    changed = true;
+  }
+  return changed;
+}
+
+bool WorkerPasses::advance(int, const std::atomic<bool>* cancel, const pt::TileCallback& on_tile) {
+  for (;;) {
+    // Keep every live worker busy plus a few passes queued, each carrying the pixels converged so
+    // far. The worker count is looked up at most once a second.
+    if (m_redis.connections() != m_published) publish();
+    if (clock::now() >= m_next_worker_count) {
+      m_workers = std::max(1, m_live_workers());
+      m_next_worker_count = clock::now() + std::chrono::seconds(1);
+    }
+    const size_t ahead = size_t(std::max(m_in_flight, m_workers + 2));
+    while (!m_plan.exhausted() && m_plan.issued() < m_merged.size() + ahead && !m_film.finished()) {
+      m_plan.next(m_film.remaining(), m_workers);
+      issue(m_plan.issued() - 1);
+    }
+    if (cancel && cancel->load()) return false;
+    if (clock::now() >= m_deadline && !m_merged.empty()) return false;  // never before a first picture
+    RedisReply r = m_redis.command({"XREAD", "COUNT", "4", "BLOCK", "100", "STREAMS", m_results, m_last_id});
+    const auto merge_start = clock::now();
+    if (!merge(r)) continue;
+    if (on_tile)
+      for (const pt::Tile& t : m_tiles) on_tile(t);
+    m_merge_seconds += std::chrono::duration<double>(clock::now() - merge_start).count();
+    return true;
+  }
+}
+
+void WorkerPasses::finish(pt::StopReason why) {
+  if (!m_started && why != pt::StopReason::cancelled) m_sink.started(m_w, m_h, {});
+  if (m_merged.empty()) return;
+  std::string sizes;
+  for (size_t u = 0; u < m_plan.issued(); ++u) sizes += (u ? " " : "") + std::to_string(m_plan.range(u).second);
+  std::fprintf(stderr, "render-server: job %s: %zu passes merged in %.3f s (%.2f ms and %.2f MB a pass), %.2f s in all; spp a pass: %s\n",
+               m_job.id.c_str(), m_merged.size(), m_merge_seconds, 1e3 * m_merge_seconds / m_merged.size(),
+               m_pass_bytes / 1e6 / m_merged.size(), seconds(), sizes.c_str());
+}
+
 class RedisBackend : public RenderBackend {
  public:
   RedisBackend(SceneLibrary& scenes, const std::string& url, int in_flight, double redis_timeout)
@@ -122,165 +295,32 @@ class RedisBackend : public RenderBackend {
   }
 
   RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop) override {
-    using clock = std::chrono::steady_clock;
     const JobSpec& spec = job.spec;
-    const pt::RenderParams& p = spec.params;
     std::string path = m_scenes.resolve(spec.scene), scene_text;
     if (path.empty() || !read_file(path, scene_text)) throw std::runtime_error("scene '" + spec.scene + "' is gone");
     // A bad file fails here, not once on every worker; the server itself builds no BVH.
     pt::parse_collada(scene_text, spec.scene + ".dae");
-    const int w = p.cell_w > 0 ? p.cell_w : p.width, h = p.cell_w > 0 ? p.cell_h : p.height;
-    const size_t pixels = size_t(w) * h;
-
     // An unreachable Redis (a restart) is waited for, up to --redis-timeout; a cancel ends the wait.
     RedisClient redis(m_address, 5.0, false);
     redis.set_patience(m_redis_timeout, &stop, "render-server: job " + job.id);
-    const std::string run = new_run_id(), job_key = rq::job_key(job.id, run), results = rq::results_key(job.id, run);
-    const std::string scene_hash = rq::content_hash(scene_text), ttl = std::to_string(rq::kKeyTtlSeconds);
-    const std::string spec_json = job_spec_to_json(spec).dump();
-    struct Cleanup {  // however the render ends, workers learn the run is over
-      RedisClient& redis;
-      std::string job_key, results;
-      ~Cleanup() {
-        try {
-          redis.set_patience(0);
-          redis.command({"DEL", job_key, results});
-        } catch (const std::exception& e) {
-          std::fprintf(stderr, "render-server: cannot clean up %s: %s\n", job_key.c_str(), e.what());
-        }
-      }
-    } cleanup{redis, job_key, results};
-
-    PassPlan plan(p.spp, pixels, p.caustic_tracing ? 32.0 : 20.0);  // the scene decides; plan for the larger
-    pt::FilmAccumulator film(p, w, h);
-    std::vector<pt::Tile> tiles;
-    for (int y = 0; y < h; y += p.tile_size)
-      for (int x = 0; x < w; x += p.tile_size) tiles.push_back({x, y, std::min(x + p.tile_size, w), std::min(y + p.tile_size, h)});
-
-    std::set<uint32_t> merged;
-    std::string last_id = "0-0";
-    auto issue = [&](size_t unit) {
-      auto [first, count] = plan.range(unit);
-      redis.command({"XADD", rq::kWorkStream, "*", "job", job.id, "run", run, "unit", std::to_string(unit), "first",
-                     std::to_string(first), "count", std::to_string(count), "mask",
-                     p.adaptive ? pt::pack_mask(film.done()) : std::string()});
-    };
-    // Puts what workers need in Redis: the group, the scene's bytes (once per content: repeated
-    // jobs on a large scene send only its hash), the run's hash. Again on every new connection:
-    // a Redis restarted without its data has lost them, and the passes issued so far, which go
-    // out again (a pass rendered twice is merged once).
-    uint64_t published = ~uint64_t(0);  // the connection the run was last published on (none yet)
-    auto publish = [&] {
-      do {
-        redis.command({"PING"});
-        published = redis.connections();
-        rq::ensure_group(redis);
-        redis.command({"SET", rq::scene_key(scene_hash), scene_text, "EX", ttl, "NX"});
-        redis.command({"EXPIRE", rq::scene_key(scene_hash), ttl});
-        bool fresh = redis.command({"HSET", job_key, "spec", spec_json, "scene", scene_hash}).integer_value > 0;
-        redis.command({"EXPIRE", job_key, ttl});
-        if (fresh && plan.issued() > merged.size()) {
-          std::fprintf(stderr,
-                       "render-server: job %s: the run's keys were gone from Redis; issuing its %zu unmerged passes again\n",
-                       job.id.c_str(), plan.issued() - merged.size());
-          for (size_t u = 0; u < plan.issued(); ++u)
-            if (!merged.count(uint32_t(u))) issue(u);
-        }
-        if (fresh) last_id = "0-0";  // results of the lost stream that came in again
-      } while (redis.connections() != published);
-    };
-
-    int workers = 1;
-    auto next_worker_count = clock::now();
-    bool started = false;
-    double merge_seconds = 0;  // decoding, merging and publishing passes: the server's cost per pass
-    size_t pass_bytes = 0;
-    auto t0 = clock::now();
-    auto elapsed = [&] { return std::chrono::duration<double>(clock::now() - t0).count(); };
+    WorkerPasses passes(job, scene_text, redis, sink, [this] { return live_workers(); }, m_in_flight);
     RenderResult result;
+    auto on_tile = [&](const pt::Tile& t) {
+      thread_local std::vector<pt::Vec3> buf;
+      passes.film().read_tile(t, buf);
+      sink.tile(t, buf);
+    };
+    auto on_pass = [&](const pt::PassReport& r) { sink.pass(passes.report(r.error)); };
     try {
-      for (;;) {
-        // Keep every live worker busy plus a few passes queued, each carrying the pixels converged
-        // so far. The worker count is looked up at most once a second.
-        if (redis.connections() != published) publish();
-        if (clock::now() >= next_worker_count) {
-          workers = std::max(1, live_workers());
-          next_worker_count = clock::now() + std::chrono::seconds(1);
-        }
-        const size_t ahead = size_t(std::max(m_in_flight, workers + 2));
-        while (!plan.exhausted() && plan.issued() < merged.size() + ahead && !film.finished()) {
-          plan.next(film.remaining(), workers);
-          issue(plan.issued() - 1);
-        }
-        if (stop) {
-          result.why = pt::StopReason::cancelled;
-          break;
-        }
-        if (spec.time_limit > 0 && elapsed() >= spec.time_limit && !merged.empty()) {
-          result.why = pt::StopReason::time_limit;
-          break;
-        }
-        RedisReply r = redis.command({"XREAD", "COUNT", "4", "BLOCK", "100", "STREAMS", results, last_id});
-        // Everything read from Redis is checked: [[stream, [[id, [field, value, ...]], ...]]].
-        if (r.type != RedisReply::array || r.elements.empty() || r.elements[0].elements.size() < 2) continue;
-        auto merge_start = clock::now();
-        bool changed = false;
-        for (const RedisReply& e : r.elements[0].elements[1].elements) {
-          if (e.elements.size() != 2 || e.elements[0].type != RedisReply::string) continue;
-          last_id = e.elements[0].str;
-          const RedisReply& body = e.elements[1];
-          if (const std::string* err = body.field("error")) throw std::runtime_error(valid_utf8(*err, 2000));
-          const std::string* bytes = body.field("pass");
-          uint32_t u = 0;
-          if (!rq::parse_u32(body.field("unit"), u) || !bytes) continue;
-          if (u >= plan.issued() || merged.count(u)) continue;  // a pass rendered twice (its first worker looked dead)
-          pt::FilmPass pass = pt::FilmPass::decode(*bytes, w, h);
-          pass_bytes += bytes->size();
-          if (pass.first != plan.range(u).first || pass.count != plan.range(u).second) continue;
-          uint64_t pass_samples = 0;
-          for (uint32_t n : pass.samples) pass_samples += n;
-          plan.observe(pass_samples, pass.seconds);
-          if (!started) {
-            sink.started(w, h, parse_features(body.field("features")));
-            started = true;
-          }
-          film.merge(pass);
-          merged.insert(u);
-          changed = true;
-        }
-        if (!changed) continue;
-        std::vector<pt::Vec3> buf;
-        for (const pt::Tile& t : tiles) {
-          film.read_tile(t, buf);
-          sink.tile(t, buf);
-        }
-        result.report = {film.progress(), film.samples(), film.rays(), film.nonfinite(), film.error_estimate()};
-        sink.pass(result.report);
-        merge_seconds += std::chrono::duration<double>(clock::now() - merge_start).count();
-        if (spec.target_error > 0 && result.report.error <= spec.target_error) {
-          result.why = pt::StopReason::target_error;
-          break;
-        }
-        if (film.finished() || (plan.exhausted() && merged.size() == plan.issued())) {
-          result.why = pt::StopReason::finished;
-          break;
-        }
-      }
+      result.why = pt::run_progressive(passes, {spec.time_limit, spec.target_error}, &stop, on_tile, on_pass);
     } catch (const RedisUnreachable&) {
       if (!stop) throw;  // away past --redis-timeout: the job fails, saying so
       result.why = pt::StopReason::cancelled;  // cancelled (or the server stopping) while waiting
     }
-    if (!started && result.why != pt::StopReason::cancelled) sink.started(w, h, {});
-    result.image = film.image();
-    result.report = {film.progress(), film.samples(), film.rays(), film.nonfinite(), film.error_estimate()};
-    result.seconds = elapsed();
-    if (!merged.empty()) {
-      std::string sizes;
-      for (size_t u = 0; u < plan.issued(); ++u) sizes += (u ? " " : "") + std::to_string(plan.range(u).second);
-      std::fprintf(stderr, "render-server: job %s: %zu passes merged in %.3f s (%.2f ms and %.2f MB a pass), %.2f s in all; spp a pass: %s\n",
-                   job.id.c_str(), merged.size(), merge_seconds, 1e3 * merge_seconds / merged.size(),
-                   pass_bytes / 1e6 / merged.size(), result.seconds, sizes.c_str());
-    }
+    passes.finish(result.why);
+    result.image = passes.film().image();
+    result.report = passes.report(passes.error_estimate());
+    result.seconds = passes.seconds();
     return result;
   }
 

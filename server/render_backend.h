@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "render.h"
+#include "session.h"
 
 namespace srv {
 

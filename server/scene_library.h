@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "job_spec.h"
-#include "render.h"
+#include "render_scene.h"
 
 namespace srv {
 

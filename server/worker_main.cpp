@@ -19,7 +19,7 @@
 #include <thread>
 
 #include "collada.h"
-#include "film.h"
+#include "session.h"
 #include "job_spec.h"
 #include "redis_queue.h"
 

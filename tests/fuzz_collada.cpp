@@ -8,7 +8,7 @@
 #include <string>
 
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Smaller than the defaults so each input stays fast; the limit checks themselves are exercised.

@@ -16,7 +16,7 @@
 #include "bsdf_util.h"
 #include "cli.h"
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 
 using namespace pt;
 

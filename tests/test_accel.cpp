@@ -12,7 +12,7 @@
 
 #include "accel.h"
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 #include "test_util.h"
 
 using namespace pt;

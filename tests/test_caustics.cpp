@@ -10,7 +10,7 @@
 #include "caustics.h"
 #include "collada.h"
 #include "materials.h"
-#include "render.h"
+#include "session.h"
 #include "test_util.h"
 
 namespace pt {
@@ -62,7 +62,7 @@ SeedStats over_seeds(const SceneDesc& desc, RenderParams p, int seeds) {
       double l = luminance(img.pixels[i]);
       s1[i] += l, s2[i] += l * l;
     }
-    if (s == 0) st.caustics = session.caustic_image();
+    if (s == 0) st.caustics = session.film().caustic_image();
     st.light_paths += session.stats().light_paths;
   }
   for (size_t k = 0; k < blocks[0].size(); ++k) {

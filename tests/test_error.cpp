@@ -5,7 +5,7 @@
 #include <random>
 
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 #include "test_util.h"
 
 using namespace pt;
@@ -313,9 +313,9 @@ TEST(ErrorEstimateCache, OncePerPassNeverStaleAfterAPassEvenACutOne) {
                                          [&](const PassReport& r) { passes.push_back(r); });
   EXPECT_EQ(why, StopReason::cancelled);
   ASSERT_EQ(passes.size(), 4u);
-  EXPECT_EQ(cut.error_estimates_computed(), 4u) << "one estimate a pass";
+  EXPECT_EQ(cut.film().error_estimates_computed(), 4u) << "one estimate a pass";
   EXPECT_EQ(cut.error_estimate(), passes.back().error) << "the last pass's samples, the half-pass included";
-  EXPECT_EQ(cut.error_estimates_computed(), 4u) << "asked again with no new samples: not computed again";
+  EXPECT_EQ(cut.film().error_estimates_computed(), 4u) << "asked again with no new samples: not computed again";
   EXPECT_NE(passes[2].error, passes[3].error) << "the cut pass added samples, and its estimate saw them";
 
   // Asked after every pass or only at the end, the same statistics give the same estimate.
@@ -327,7 +327,7 @@ TEST(ErrorEstimateCache, OncePerPassNeverStaleAfterAPassEvenACutOne) {
     once.render_pass(target);
   }
   EXPECT_EQ(once.error_estimate(), each.back());
-  EXPECT_EQ(once.error_estimates_computed(), 1u);
+  EXPECT_EQ(once.film().error_estimates_computed(), 1u);
   EXPECT_NE(each[0], each[1]);
   EXPECT_NE(each[1], each[2]);
 }

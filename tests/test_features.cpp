@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 #include "test_util.h"
 
 using namespace pt;

@@ -6,11 +6,17 @@
 #include <cmath>
 
 #include "collada.h"
-#include "film.h"
+#include "session.h"
 #include "test_util.h"
 
 namespace pt {
 namespace {
+
+uint64_t samples_in(const Film& film) {
+  uint64_t n = 0;
+  for (size_t i = 0; i < film.pixels(); ++i) n += film.count(i);
+  return n;
+}
 
 struct Fixture {
   RenderParams params;
@@ -36,8 +42,8 @@ TEST(Film, DisjointPassesMergeIntoTheSessionImage) {
   ImageRGB whole = session.image();
 
   // Out of order and uneven, as workers return them.
-  FilmAccumulator film(f.params, 48, 36);
-  FilmAccumulator asked_once(f.params, 48, 36);  // the same merges, its estimate asked for only at the end
+  Film film(48, 36, f.params.spp, adaptive_rule(f.params), false);
+  Film asked_once(48, 36, f.params.spp, adaptive_rule(f.params), false);  // the same merges, its estimate asked for only at the end
   std::vector<double> estimates;
   for (auto [first, count] : {std::pair<uint32_t, uint32_t>{8, 8}, {0, 1}, {2, 2}, {1, 1}, {4, 4}}) {
     const FilmPass pass = render_film_pass(*f.scene, f.params, first, count, {}, nullptr);
@@ -49,7 +55,7 @@ TEST(Film, DisjointPassesMergeIntoTheSessionImage) {
   for (size_t k = 1; k < estimates.size(); ++k) EXPECT_NE(estimates[k], estimates[k - 1]) << k;
   EXPECT_EQ(asked_once.error_estimate(), estimates.back());
   EXPECT_TRUE(film.finished());
-  EXPECT_EQ(film.samples(), 48u * 36u * 16u);
+  EXPECT_EQ(samples_in(film), 48u * 36u * 16u);
   EXPECT_DOUBLE_EQ(film.progress(), 1.0);
   ImageRGB merged = film.image();
   double worst = 0;
@@ -61,7 +67,7 @@ TEST(Film, DisjointPassesMergeIntoTheSessionImage) {
   EXPECT_GT(session.stats().light_paths, 0u);
   EXPECT_EQ(film.light_paths(), session.stats().light_paths);
   // Different samples make a visibly different image: the check above can fail.
-  FilmAccumulator other(f.params, 48, 36);
+  Film other(48, 36, f.params.spp, adaptive_rule(f.params), false);
   other.merge(render_film_pass(*f.scene, f.params, 16, 16, {}, nullptr));
   double diff = 0;
   for (size_t i = 0; i < whole.pixels.size(); ++i) diff = std::max(diff, double(std::abs(other.image().pixels[i][0] - whole.pixels[i][0])));
@@ -122,17 +128,62 @@ TEST(Film, SkippedPixelsTakeNoSamplesAndMasksRoundTrip) {
 
 TEST(Film, AdaptiveSamplingConvergesOnMergedStatistics) {
   Fixture f(1024, true);
-  FilmAccumulator film(f.params, 48, 36);
+  Film film(48, 36, f.params.spp, adaptive_rule(f.params), false);
   uint64_t taken = 0;
   for (uint32_t first = 0; first < 1024 && !film.finished(); first += 64) {
-    FilmPass p = render_film_pass(*f.scene, f.params, first, 64, film.done(), nullptr);
+    FilmPass p = render_film_pass(*f.scene, f.params, first, 64, film.done_mask(), nullptr);
     for (uint32_t c : p.samples) taken += c;
     film.merge(p);
   }
-  EXPECT_EQ(film.samples(), taken);
+  EXPECT_EQ(samples_in(film), taken);
   // Converged pixels (the flat walls) stop early: far fewer samples than the budget.
   EXPECT_LT(double(taken), 0.8 * 48 * 36 * 1024);
   EXPECT_GT(film.progress(), 0.99);
+  // The one rule: a pixel stopped before the budget crossed a test count (65, 129, ... for a batch
+  // of 32) in its last pass of 64.
+  for (size_t i = 0; i < film.pixels(); ++i)
+    if (film.done(i) && film.count(i) < 1024u)
+      EXPECT_TRUE(film.rule().test_due_within(film.count(i) - 64, film.count(i))) << i << ": " << film.count(i);
+}
+
+TEST(Film, AdaptiveRuleTestsAfterEachBatch) {
+  AdaptiveRule rule{true, 32, 0.05};
+  EXPECT_FALSE(rule.test_due(1));
+  EXPECT_FALSE(rule.test_due(32));
+  EXPECT_TRUE(rule.test_due(33));
+  EXPECT_TRUE(rule.test_due(65));
+  EXPECT_EQ(rule.next_test(0), 33u);
+  EXPECT_EQ(rule.next_test(32), 33u);
+  EXPECT_EQ(rule.next_test(33), 65u);
+  EXPECT_TRUE(rule.test_due_within(32, 64));
+  EXPECT_FALSE(rule.test_due_within(33, 64));
+  EXPECT_TRUE(rule.test_due_within(33, 65));
+  AdaptiveRule every{true, 1, 0.05};
+  EXPECT_TRUE(every.test_due(2));
+  EXPECT_EQ(every.next_test(5), 6u);
+  AdaptiveRule off{false, 32, 0.05};
+  EXPECT_FALSE(off.test_due(33));
+  EXPECT_FALSE(off.test_due_within(0, 1000));
+  // 1.96 sqrt(var / n) <= tolerance x mean: luminances 1 and 3, n = 2: mean 2, var 2, half-width 1.96.
+  EXPECT_FALSE(rule.converged(4, 10, 2));
+  EXPECT_TRUE((AdaptiveRule{true, 32, 0.98}.converged(4, 10, 2)));
+  EXPECT_TRUE(rule.converged(2 * 40, 4 * 40, 40)) << "a constant pixel has converged";
+}
+
+TEST(Film, SessionPixelsStopOnlyAtTestCounts) {
+  Fixture f(256, true);
+  f.params.adaptive_batch = 8;
+  RenderSession session(*f.scene, f.params);
+  ASSERT_TRUE(session.render_all());
+  const Film& film = session.film();
+  size_t stopped = 0;
+  for (size_t i = 0; i < film.pixels(); ++i) {
+    ASSERT_TRUE(film.done(i));
+    if (film.count(i) == 256u) continue;
+    ++stopped;
+    EXPECT_TRUE(film.rule().test_due(film.count(i))) << i << ": " << film.count(i);
+  }
+  EXPECT_GT(stopped, film.pixels() / 4) << "the walls converge early";
 }
 
 }  // namespace

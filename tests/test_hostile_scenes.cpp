@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 #include "test_util.h"
 
 namespace pt {

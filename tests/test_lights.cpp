@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "bsdf_util.h"
-#include "render.h"
+#include "session.h"
 #include "rng.h"
 #include "stat_util.h"
 

@@ -8,7 +8,7 @@
 
 #include "collada.h"
 #include "diffuse_lanes.h"
-#include "render.h"
+#include "session.h"
 #include "test_util.h"
 
 using namespace pt;
@@ -83,7 +83,7 @@ TEST(Packets, BatchedPathsRenderWhatThePathByPathLoopRenders) {
     ASSERT_EQ(a.pixels.size(), b.pixels.size());
     EXPECT_LE(differing_pixels(a, b), a.pixels.size() / 200) << "more than 0.5% of the pixels differ";
     EXPECT_EQ(batched.stats().samples, single.stats().samples);
-    EXPECT_EQ(batched.pixel_counts(), single.pixel_counts()) << "adaptive stops differ";
+    EXPECT_EQ(batched.film().done_mask(), single.film().done_mask()) << "adaptive stops differ";
     EXPECT_GT(batched.stats().samples, 0u);
     double ra = double(batched.stats().rays), rb = double(single.stats().rays);
     EXPECT_NEAR(ra, rb, 0.002 * rb) << "the batched loop counts its rays as the scalar one does";
@@ -121,7 +121,7 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
       ASSERT_EQ(a.pixels.size(), b.pixels.size());
       EXPECT_EQ(differing_pixels(a, b), 0u);
       EXPECT_EQ(with.stats().rays, without.stats().rays);
-      EXPECT_EQ(with.pixel_counts(), without.pixel_counts());
+      EXPECT_EQ(with.film().done_mask(), without.film().done_mask());
       EXPECT_EQ(with.stats().nonfinite, 0u);
     }
   }

@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 #include "test_util.h"
 
 using namespace pt;

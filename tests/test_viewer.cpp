@@ -21,7 +21,7 @@
 
 #include "cli.h"
 #include "collada.h"
-#include "render.h"
+#include "session.h"
 #include "test_util.h"
 
 using namespace pt;

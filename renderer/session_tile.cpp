@@ -2,7 +2,7 @@
 // in Embree packets), and the per-pixel statistics every estimate and stop rule reads.
 #include <algorithm>
 
-#include "render.h"
+#include "session.h"
 
 namespace pt {
 
@@ -23,64 +23,10 @@ void RenderSession::camera_ray(int fx, int fy_up, Sampler& rng, Ray& r) const {
   cam.generate_ray(s.x, s.y, lens, r);
 }
 
-__attribute__((always_inline)) inline bool RenderSession::add_sample(size_t i, uint32_t s, Vec3 l, uint64_t& samples,
-                                                                     uint64_t& nonfinite) {
-  if (!is_finite(l)) {  // dropped and counted; a bug to fix at its source
-    ++nonfinite;
-    l = Vec3(0.0f);
-  }
-  if (s > 0 && (s & (s - 1)) == 0) {  // s samples so far, a power of two: keep their sum
-    m_half_s1[i] = m_s1[i];
-    m_half_n[i] = s;
-  }
-  m_sum[i] += l;
-  double lum = luminance(l);
-  m_s1[i] += lum;
-  m_s2[i] += lum * lum;
-  uint32_t n = ++m_count[i];
-  ++samples;
-  // Course adaptive sampling: after sample index n-1 > 0 that is a multiple of the batch, stop once
-  // the 95% confidence half-width is within tolerance x mean.
-  const int batch = std::max(1, m_params.adaptive_batch);
-  return m_params.adaptive && n > 1 && (n - 1) % batch == 0 &&
-         confidence_reached(m_s1[i], m_s2[i], n, m_params.adaptive_tolerance);
-}
-
-// Samples [from, to) of pixel i that sees only background: add_sample with l = 0 for each, minus
-// the sums, which adding zeros leaves as they are. Stops after the first adaptive test that passes;
-// returns the number of samples added.
-uint32_t RenderSession::add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stopped) {
-  const uint32_t batch = uint32_t(std::max(1, m_params.adaptive_batch));
-  stopped = false;
-  if (!m_params.adaptive && from < to) {  // no stop test: only the last power of two in [from, to) is kept
-    const uint32_t last = 1u << (31 - __builtin_clz((to - 1) | 1));  // the largest power of two <= max(to - 1, 1)
-    if (to > 1 && last >= from) {
-      m_half_s1[i] = m_s1[i];
-      m_half_n[i] = last;
-    }
-    m_count[i] = to;
-    return to - from;
-  }
-  uint32_t s = from;
-  while (s < to) {
-    if (s > 0 && (s & (s - 1)) == 0) {
-      m_half_s1[i] = m_s1[i];
-      m_half_n[i] = s;
-    }
-    const uint32_t n = ++s;
-    if (m_params.adaptive && n > 1 && (n - 1) % batch == 0 &&
-        confidence_reached(m_s1[i], m_s2[i], n, m_params.adaptive_tolerance)) {
-      stopped = true;
-      break;
-    }
-  }
-  m_count[i] = s;
-  return s - from;
-}
-
 void RenderSession::render_tile(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,
                                 uint64_t& samples, uint64_t& nonfinite) {
   const RenderParams& p = m_params;
+  const int w = width();
   if (p.ray_packets) {
     if (PathBatchTracer many = path_batch_tracer_for(m_scene.features.bits, p)) {
       render_tile_batched(t, target, cancel, rays, samples, nonfinite, many);
@@ -92,15 +38,15 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
     if (stop_requested(cancel)) return;
     uint64_t row_credit = 0;  // one update of the shared counter per row: see render_tile_batched
     for (int x = t.x0; x < t.x1; ++x) {
-      size_t i = size_t(y) * m_w + x;
-      if (m_done[i]) continue;
+      size_t i = size_t(y) * w + x;
+      if (m_film.done(i)) continue;
       int fx = m_frame_x0 + x, fy_top = m_frame_y0 + y;
       int fy_up = p.height - 1 - fy_top;  // course pixel rows count from the bottom
       uint64_t pixel_index = uint64_t(fy_top) * p.width + fx;
       const bool background = background_pixel(i, x, y);
-      uint32_t before = m_count[i];
-      while (m_count[i] < uint32_t(target)) {
-        uint32_t s = m_count[i];
+      uint32_t before = m_film.count(i);
+      while (m_film.count(i) < uint32_t(target)) {
+        uint32_t s = m_film.count(i);
         if ((s & 15) == 15 && stop_requested(cancel)) break;
         Vec3 l(0.0f);
         if (background) {
@@ -111,13 +57,14 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
           camera_ray(fx, fy_up, rng, ray);
           l = trace(m_scene, p, ray, rng, rays);
         }
-        if (add_sample(i, s, l, samples, nonfinite)) {
-          m_done[i] = 1;
+        ++samples;
+        if (m_film.add_sample(i, s, l, nonfinite)) {
+          m_film.set_done(i);
           break;
         }
       }
-      if (m_count[i] >= uint32_t(p.spp)) m_done[i] = 1;
-      row_credit += m_done[i] ? uint64_t(p.spp) - before : uint64_t(m_count[i] - before);
+      if (m_film.count(i) >= uint32_t(p.spp)) m_film.set_done(i);
+      row_credit += m_film.done(i) ? uint64_t(p.spp) - before : uint64_t(m_film.count(i) - before);
     }
     m_budget_done.fetch_add(row_credit, std::memory_order_relaxed);
   }
@@ -131,7 +78,8 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
 void RenderSession::render_tile_batched(const Tile& t, int target, const std::atomic<bool>* cancel, uint64_t& rays,
                                         uint64_t& samples, uint64_t& nonfinite, PathBatchTracer trace) {
   const RenderParams& p = m_params;
-  const uint32_t batch = uint32_t(std::max(1, p.adaptive_batch));
+  const AdaptiveRule& rule = m_film.rule();
+  const int w = width();
   constexpr size_t kJobs = 2048;  // paths per batch: bounds memory and the latency of a cancel
   const bool lens = m_scene.camera.lens_radius > 0;
   // With Sobol draws in lanes, the camera's draws come from each job's pixel base and sample index
@@ -190,10 +138,11 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
     out.resize(n);
     if (n) trace(m_scene, p, camera_rays.data(), rngs.data(), n, out.data(), rays);
+    samples += n;
     for (size_t k = 0; k < n; ++k)  // job k traced camera ray k
-      if (add_sample(jobs[k].pixel, jobs[k].sample, out[k], samples, nonfinite)) {
-        m_done[jobs[k].pixel] = 1;
-        stopped_credit += uint64_t(p.spp) - m_count[jobs[k].pixel];
+      if (m_film.add_sample(jobs[k].pixel, jobs[k].sample, out[k], nonfinite)) {
+        m_film.set_done(jobs[k].pixel);
+        stopped_credit += uint64_t(p.spp) - m_film.count(jobs[k].pixel);
       }
     njobs = 0;
     stopped = stop_requested(cancel);
@@ -202,22 +151,22 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     again = false;
     for (int y = t.y0; y < t.y1 && !stopped; ++y) {
       for (int x = t.x0; x < t.x1 && !stopped; ++x) {
-        size_t i = size_t(y) * m_w + x;
-        uint32_t c = m_count[i];
-        if (m_done[i] || c >= uint32_t(target)) continue;
+        size_t i = size_t(y) * w + x;
+        uint32_t c = m_film.count(i);
+        if (m_film.done(i) || c >= uint32_t(target)) continue;
         uint32_t end = uint32_t(target);
-        if (p.adaptive) {  // up to the next stop test: after sample n with n > 1 and n - 1 a multiple of the batch
-          uint32_t test = 1 + batch * ((std::max(c, 1u) + batch - 1) / batch);
+        if (rule.enabled) {  // up to the pixel's next stop test
+          uint32_t test = rule.next_test(c);
           if (test < end) end = test, again = true;
         }
         if (background_pixel(i, x, y)) {  // zeros of its own: no job, no ray (but counted as the camera ray it would be)
           bool stop;
-          uint32_t added = add_zero_samples(i, c, end, stop);
+          uint32_t added = m_film.add_zero_samples(i, c, end, stop);
           rays += added;
           samples += added;
           if (stop) {
-            m_done[i] = 1;
-            stopped_credit += uint64_t(p.spp) - m_count[i];
+            m_film.set_done(i);
+            stopped_credit += uint64_t(p.spp) - m_film.count(i);
           }
           continue;
         }
@@ -243,8 +192,8 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   }
   for (int y = t.y0; y < t.y1; ++y)
     for (int x = t.x0; x < t.x1; ++x) {
-      size_t i = size_t(y) * m_w + x;
-      if (m_count[i] >= uint32_t(p.spp)) m_done[i] = 1;
+      size_t i = size_t(y) * w + x;
+      if (m_film.count(i) >= uint32_t(p.spp)) m_film.set_done(i);
     }
   // The credit in one update: the counter is shared by the threads, and an atomic add per pixel
   // would move its cache line between cores a thousand times a tile.

@@ -1,0 +1,83 @@
+// The progressive driver, the one loop every render runs: the CLI, the window, the embedded job
+// backend and the scale-out's server. It asks a PassSource for passes of growing sample counts
+// and stops on the sample budget, the error target, the time limit or a cancel.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+
+#include "film.h"
+#include "options.h"
+
+namespace pt {
+
+using TileCallback = std::function<void(const Tile&)>;
+
+// What a progressive render runs on: a session rendering passes here (session.h), or the
+// scale-out's server gathering workers' passes (server/redis_backend.cpp).
+class PassSource {
+ public:
+  virtual ~PassSource() = default;
+  // Takes every unfinished pixel towards `target_spp` samples: a pass over the frame here, or the
+  // workers' passes merged since the last call. `on_tile` after each tile that changed. False
+  // when it stopped early: `cancel` set, or the deadline passed.
+  virtual bool advance(int target_spp, const std::atomic<bool>* cancel, const TileCallback& on_tile) = 0;
+  // Passes stop, as if cancelled, once this time has passed.
+  virtual void set_deadline(std::chrono::steady_clock::time_point t) = 0;
+  virtual const Film& film() const = 0;
+  virtual double seconds() const = 0;  // rendering time so far
+  virtual double error_estimate() const { return film().error_estimate(); }
+  // Nothing left to render: every pixel done (gathered: also every pass asked for merged).
+  virtual bool finished() const { return film().finished(); }
+};
+
+enum class StopReason { finished, target_error, time_limit, cancelled };
+const char* stop_reason_name(StopReason r);
+
+struct PassReport {
+  int target_spp;   // samples per pixel this pass aimed for
+  double seconds;   // rendering time so far
+  double error;     // the error estimate after the pass
+  bool completed;   // false: cut short by a cancel or the time limit
+};
+
+// Seconds left of a progressive render `elapsed` seconds in: from the sample budget (`progress`,
+// the fraction done), or sooner from the error estimate `error` measured at `error_seconds`, which
+// an unbiased estimator's relative MSE lowers as 1/time towards limits.target_error (not a
+// sample fraction: most of the budget may never be needed), or sooner still from the time limit.
+// Negative while none of them says anything (no progress, no limit). The CLI's progress bar and
+// the job service's ETA both use it.
+double remaining_seconds(double elapsed, double progress, double error, double error_seconds, const RunLimits& limits);
+// The samples per pixel the pass after one that reached `target` aims for: twice as many (1, 2, 4,
+// ... spp), or, towards an error target, where the estimate's 1/spp decay meets it when that comes
+// sooner (a doubling could overshoot it by up to the render's whole time so far).
+int next_pass_target(int target, int spp, double error, double target_error);
+
+// The driver, a pass at a time: the window runs it step by step, pausing (cancelling a pass) to
+// handle input between steps; run_progressive runs it to the end.
+class ProgressiveDriver {
+ public:
+  ProgressiveDriver(PassSource& source, const RunLimits& limits) : m_source(source), m_limits(limits) {}
+  // Runs the next pass. A pass cut short by `cancel` leaves the render resumable (the next step
+  // resumes it); one cut short by the time limit ends it. The time limit counts rendering time
+  // (PassSource::seconds), so pauses between steps do not use it up.
+  PassReport step(const std::atomic<bool>* cancel = nullptr, const TileCallback& on_tile = {});
+  bool done() const { return m_done; }
+  StopReason reason() const { return m_reason; }
+  int target() const { return m_target; }
+
+ private:
+  PassSource& m_source;
+  RunLimits m_limits;
+  int m_target = 1;
+  bool m_done = false;
+  StopReason m_reason = StopReason::finished;
+};
+
+// Steps the driver until the render ends; `on_pass` after each pass (also the last, partial one).
+// A cancel ends it (StopReason::cancelled).
+StopReason run_progressive(PassSource& source, const RunLimits& limits, const std::atomic<bool>* cancel = nullptr,
+                           const TileCallback& on_tile = {}, const std::function<void(const PassReport&)>& on_pass = {});
+
+}  // namespace pt

@@ -1,0 +1,30 @@
+// The path loop (integrator.cpp): one camera path's radiance, one path at a time or many at once in
+// Embree packets, specialised on the scene's feature bits. Below the session, which drives it.
+#pragma once
+
+#include <cstdint>
+
+#include "render_scene.h"
+#include "sampler.h"
+
+namespace pt {
+
+// One camera path's radiance (integrator.cpp), by the generic loop. `rays` counts every ray cast.
+Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, class Sampler& rng, uint64_t& rays);
+// The path loop specialised for a set of feature bits (one instantiation per combination).
+using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class Sampler&, uint64_t&);
+PathTracer path_tracer_for(uint32_t feature_bits);
+// The same paths, many at once: traces camera_rays[0, n) with samplers rngs[0, n) (each already
+// past its pixel and lens draws) and writes each path's radiance to out[i]. Rays go to Embree in
+// packets (Accel::intersect_many). nullptr where the scalar loop must run (-H).
+using PathBatchTracer = void (*)(const RenderScene&, const RenderParams&, const Ray* camera_rays, class Sampler* rngs,
+                                 size_t n, Vec3* out, uint64_t& rays);
+PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const RenderParams& params);
+// Whether the batched loop takes its diffuse vertices four at a time in SSE2 lanes
+// (diffuse_lanes.h): packets, every light an area light (rectangle or mesh), and not --no-simd-lanes.
+bool diffuse_lanes_apply(const RenderScene& scene, const RenderParams& params);
+// Whether packets take their Sobol draws eight at a time (Sampler::next_2d_many / sobol_draws):
+// the Sobol sampler, lanes not turned off, and a CPU with AVX2.
+bool sobol_draws_in_lanes(const RenderParams& params);
+
+}  // namespace pt

@@ -1,0 +1,89 @@
+// What a render reads of a scene: the view-independent SceneBase (BVH, lights, materials, the
+// feature analysis; shared by every view of one file) and the RenderScene one set of options sees
+// (camera, environment map, the features the path loop is specialised on). Built by render_scene.cpp.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "accel.h"
+#include "camera.h"
+#include "caustics.h"
+#include "image.h"
+#include "lights.h"
+#include "options.h"
+#include "scene.h"
+
+namespace pt {
+
+// Feature bits the path loop is specialised on: a scene pays only for what it has.
+enum FeatureBits : uint32_t {
+  kFeatDelta = 1,        // mirror, glass or refraction materials
+  kFeatMicrofacet = 2,   // microfacet materials
+  kFeatInfinite = 4,     // ambient or environment lights (escaping rays look them up)
+  kFeatAll = 7,
+};
+
+struct SceneFeatures {
+  std::vector<std::string> materials, lights;
+  bool spheres = false, meshes = false, environment = false, thin_lens = false;
+  bool adaptive = false, shading_normals = false;
+  bool caustic_tracing = false;  // caustics by light tracing (caustics.h)
+  uint32_t bits = kFeatAll;  // which specialised path loop runs
+};
+
+// The view-independent part of a render scene: built once per scene file and shared read-only by
+// every view of it (the server keeps one per file content). It keeps no vertex arrays of the file:
+// only the BVH and what a view needs (the file's camera and the geometry bounds).
+struct SceneBase {
+  std::vector<Material> materials;  // the file's, then one emission material per area-light panel
+  std::vector<Light> lights;        // without the environment map (that is a render option)
+  std::shared_ptr<const Accel> accel;
+  SceneFeatures features;           // what the file contains; a view adds the options' features
+  size_t triangle_count = 0, sphere_count = 0;
+  CameraDesc camera;                // what make_camera reads of the file
+  Bounds3 bounds;
+  std::vector<CausticTarget> caustic_targets;  // bounds of the delta-material geometry
+  std::vector<Bounds3> object_bounds;  // each mesh, sphere and light panel, padded as Accel pads its bounds
+  std::string source;
+
+  // Bytes held for rendering: BVH and geometry (Accel::memory_bytes), lights, materials.
+  size_t memory_bytes() const;
+};
+
+struct RenderScene {
+  std::vector<Material> materials;
+  std::vector<Light> lights;
+  std::vector<int> infinite_lights;  // ambient / environment, looked up when rays escape
+  int environment_light = -1;        // visible to camera rays
+  std::shared_ptr<const EnvironmentMap> environment;
+  std::shared_ptr<const Accel> accel;  // shared with the SceneBase and its other views
+  Camera camera;
+  SceneFeatures features;
+  size_t triangle_count = 0, sphere_count = 0;
+  // What the caustic light tracer samples: delta geometry to aim at, area and mesh lights by power.
+  std::vector<CausticTarget> caustic_targets;
+  std::vector<Bounds3> object_bounds;  // from SceneBase: what the background mask projects
+  std::vector<int> caustic_lights;
+  Distribution1D caustic_light_distribution;
+};
+
+// Builds what the integrator needs from the file's description: lights (area lights also as
+// visible panels, emissive meshes as mesh lights), the environment map, the camera, the BVH.
+// The same as make_view(make_scene_base(desc), params).
+std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params);
+// The expensive, options-independent part: lights, materials, the BVH, the feature analysis.
+SceneBase make_scene_base(const SceneDesc& desc);
+// One view of a shared base for a set of options: the camera, the environment map, the options'
+// features. Cheap (copies materials and lights); the view shares the base's BVH.
+std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams& params);
+// The camera part of the render options (what make_render_scene passes to make_camera).
+CameraParams camera_params(const RenderParams& params);
+
+// Distance along the pinhole ray through sensor point (sx, sy) (y up) to the first surface, or
+// infinity: what autofocus sets the focal distance to, as in the course.
+float autofocus_distance(const RenderScene& scene, float sx, float sy);
+
+}  // namespace pt

@@ -1,0 +1,314 @@
+// The render session (session.h): tiles, passes on the render threads, the scene rectangle that
+// background pixels skip, and the light tracer's share of each pass.
+#include "session.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <thread>
+
+#include <time.h>
+
+#include "materials.h"
+#include "sampler.h"
+
+namespace pt {
+
+namespace {
+// This thread's CPU time in nanoseconds (CLOCK_THREAD_CPUTIME_ID): what it ran, not what it waited.
+uint64_t thread_cpu_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return uint64_t(t.tv_sec) * 1000000000u + uint64_t(t.tv_nsec);
+}
+}  // namespace
+
+AdaptiveRule adaptive_rule(const RenderParams& params) {
+  return {params.adaptive, uint32_t(std::max(1, params.adaptive_batch)), params.adaptive_tolerance};
+}
+
+namespace {
+int film_width(const RenderParams& p) { return p.cell_w > 0 ? p.cell_w : p.width; }
+int film_height(const RenderParams& p) { return p.cell_w > 0 ? p.cell_h : p.height; }
+}  // namespace
+
+RenderSession::RenderSession(const RenderScene& scene, const RenderParams& params)
+    : m_scene(scene),
+      m_params((params.validate(), params)),
+      m_frame_x0(params.cell_w > 0 ? params.cell_x : 0),
+      // the cell's bottom-left origin, as a top-left one
+      m_frame_y0(params.cell_w > 0 ? params.height - (params.cell_y + params.cell_h) : 0),
+      m_caustics_light_traced(caustic_tracing_applies(scene, params)),
+      m_film(film_width(params), film_height(params), params.spp, adaptive_rule(params), m_caustics_light_traced) {
+  m_params.caustics_light_traced = m_caustics_light_traced;
+  const int w = width(), h = height();
+  if (m_caustics_light_traced) m_caustic_film = {params.width, params.height, m_frame_x0, m_frame_y0, w, h};
+  int ts = params.tile_size;
+  for (int y = 0; y < h; y += ts)
+    for (int x = 0; x < w; x += ts) m_tiles.push_back({x, y, std::min(x + ts, w), std::min(y + ts, h)});
+  find_scene_rectangle();
+  // Before any pass, a tile's cost is its pixels that see the scene.
+  m_tile_ns.assign(m_tiles.size(), 0);
+  for (size_t t = 0; t < m_tiles.size(); ++t) {
+    const Tile& tile = m_tiles[t];
+    uint64_t seen = 0;
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      if (m_background.empty()) {
+        for (int x = tile.x0; x < tile.x1; ++x) seen += !background_pixel(size_t(y) * w + x, x, y);
+        continue;
+      }
+      const uint8_t* row = m_background.data() + size_t(y) * w;
+      for (int x = tile.x0; x < tile.x1; ++x) seen += row[x] == 0;
+    }
+    m_tile_ns[t] = seen;
+  }
+  order_tiles_by_cost();
+}
+
+void RenderSession::order_tiles_by_cost() {
+  m_tile_order.resize(m_tiles.size());
+  for (size_t t = 0; t < m_tiles.size(); ++t) m_tile_order[t] = uint32_t(t);
+  std::stable_sort(m_tile_order.begin(), m_tile_order.end(),
+                   [&](uint32_t a, uint32_t b) { return m_tile_ns[a] > m_tile_ns[b]; });
+}
+
+// Where the scene's (padded) bounding box projects on the sensor of a camera in front of it. The
+// box is convex and wholly in front, so every pinhole ray that can hit it passes inside the box
+// spanned by its eight projected corners; a pixel wholly outside (with a pixel of margin) sees only
+// background. Without an environment seen by the camera, background is exactly black and the
+// path loop would stop at its first, missed query: the sample is black and counts one ray.
+// A thin lens sees a point at depth z from lens point l at sensor position p/z - l (1/z - 1/f)
+// (camera.cpp's ray through the focus point p f / z): the rectangle grows by the lens radius times
+// the largest |1/z - 1/f| over the box, which a corner (the nearest or farthest) attains.
+namespace {
+
+// The frame-pixel rectangle (y up, unclipped, without margin) holding box [lo, hi] as the camera
+// sees it, or false when a corner lies beside or behind the camera (no rectangle holds it).
+bool project_box(const Camera& cam, int width, int height, Vec3 lo, Vec3 hi, float r[4]) {
+  const bool lens = cam.lens_radius > 0;
+  float u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf, blur = 0;
+  for (int c = 0; c < 8; ++c) {
+    Vec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+    Vec3 v = corner - cam.position;
+    float z = -dot(v, cam.back);
+    if (!(z > 1e-3f * length(v))) return false;
+    float u = (dot(v, cam.right) / (z * cam.tan_half_w) + 1) * 0.5f * float(width);
+    float w = (dot(v, cam.up) / (z * cam.tan_half_h) + 1) * 0.5f * float(height);
+    if (!std::isfinite(u) || !std::isfinite(w)) return false;
+    u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, w), v1 = std::max(v1, w);
+    if (lens) blur = std::max(blur, cam.lens_radius * std::fabs(1 / z - 1 / cam.focal_distance));
+  }
+  if (lens) {  // blur is in sensor units (tan); pixels per unit differ along x and y
+    float bu = blur * 0.5f * float(width) / cam.tan_half_w, bv = blur * 0.5f * float(height) / cam.tan_half_h;
+    if (!std::isfinite(bu) || !std::isfinite(bv)) return false;
+    u0 -= bu, u1 += bu, v0 -= bv, v1 += bv;
+  }
+  r[0] = u0, r[1] = u1, r[2] = v0, r[3] = v1;
+  return true;
+}
+
+}  // namespace
+
+void RenderSession::find_scene_rectangle() {
+  const Camera& cam = m_scene.camera;
+  const int w = width(), h = height();
+  Vec3 lo, hi;
+  if (!m_scene.accel || !m_scene.accel->hit_bounds(lo, hi)) return;
+  if (!(cam.tan_half_w > 0) || !(cam.tan_half_h > 0)) return;
+  if (cam.lens_radius > 0 && !(cam.focal_distance > 0 && std::isfinite(cam.focal_distance))) return;
+  float r[4];
+  if (!project_box(cam, m_params.width, m_params.height, lo, hi, r)) return;
+  m_scene_u0 = r[0] - 1, m_scene_u1 = r[1] + 1, m_scene_v0 = r[2] - 1, m_scene_v1 = r[3] + 1;
+  // The caustic light paths are counted on this area, clipped to the full frame (not to a crop or
+  // cell window, so that windows trace the frame's paths): a box around a close camera projects far
+  // past the frame, and light paths only splat inside it.
+  auto clipped = [](float a, float b, float size) {
+    return std::max(0.0, double(std::min(b, size)) - double(std::max(a, 0.0f)));
+  };
+  m_scene_pixels = clipped(m_scene_u0, m_scene_u1, float(m_params.width)) * clipped(m_scene_v0, m_scene_v1, float(m_params.height));
+  m_background_rect = m_scene.environment_light < 0;
+  if (!m_background_rect || size_t(w) * h > (size_t(1) << 24)) return;
+
+  // Within the rectangle, the pixels no object's own rectangle reaches (the sky above an open
+  // floor), for a bounded number of objects: the mask starts as "no object" and each object's
+  // rectangle clears its rows' spans. Without that (no objects, too many, or one that does not
+  // project), the rectangle alone decides.
+  const auto& objects = m_scene.object_bounds;
+  bool by_objects = !objects.empty() && objects.size() <= kMaxMaskedObjects;
+  m_background.assign(size_t(w) * h, by_objects ? 1 : 0);
+  for (size_t k = 0; k < objects.size() && by_objects; ++k) {
+    const Bounds3& b = objects[k];
+    if (!project_box(cam, m_params.width, m_params.height, b.lo, b.hi, r)) {
+      by_objects = false;
+      std::fill(m_background.begin(), m_background.end(), uint8_t(0));
+      break;
+    }
+    // Film pixels whose frame pixel [fx, fx + 1] x [fy, fy + 1] meets the rectangle grown by a pixel.
+    auto px = [](float v, int size) { return int(std::clamp(v, -4.0f, float(size) + 4)); };
+    int fx0 = px(std::floor(r[0] - 2), m_params.width), fx1 = px(std::ceil(r[1] + 1), m_params.width);
+    int fy0 = px(std::floor(r[2] - 2), m_params.height), fy1 = px(std::ceil(r[3] + 1), m_params.height);
+    int x0 = std::max(fx0 - m_frame_x0, 0), x1 = std::min(fx1 - m_frame_x0, w - 1);
+    if (x0 > x1) continue;
+    for (int fy_up = std::max(fy0, 0); fy_up <= std::min(fy1, m_params.height - 1); ++fy_up) {
+      int y = (m_params.height - 1 - fy_up) - m_frame_y0;
+      if (y < 0 || y >= h) continue;
+      uint8_t* row = m_background.data() + size_t(y) * w;
+      std::fill(row + x0, row + x1 + 1, uint8_t(0));
+    }
+  }
+  // Then the rectangle, which is a product of a column range and a row range.
+  std::vector<uint8_t> column_outside(static_cast<size_t>(w));
+  for (int x = 0; x < w; ++x) column_outside[size_t(x)] = outside_scene_columns(m_frame_x0 + x);
+  for (int y = 0; y < h; ++y) {
+    uint8_t* row = m_background.data() + size_t(y) * w;
+    if (outside_scene_rows(m_params.height - 1 - (m_frame_y0 + y))) std::fill(row, row + w, uint8_t(1));
+    else
+      for (int x = 0; x < w; ++x) row[x] |= column_outside[size_t(x)];
+  }
+}
+
+// Light paths per sample and pixel of the area where the scene's bounds project (find_scene_rectangle),
+// so that the splats per pixel do not depend on the framing. The light paths are aimed at the delta
+// geometry and most of them splat, so few are needed: on CBspheres at 480x360 (m = 5, 64 spp; the
+// scene covers 57520 pixels) 0.045 / 0.09 / 0.19 / 0.38 / 1.5 paths per scene pixel gave
+// efficiencies 1/(relMSE x s) of 415 / 454 / 461 / 410 / 239, against 95 without light tracing
+// (docs/performance.md). At most one light path per camera sample of the frame: a crop of a
+// large view would otherwise pay for splats that land outside it.
+constexpr double kLightPathsPerScenePixel = 0.15, kMaxLightPathsPerSample = 1.0;
+
+// The pass's share of caustic light paths, before its tiles so that tiles published during the
+// pass include them. Splats are merged in path order: images do not depend on the thread count.
+// The light paths that go with camera samples [0, samples): counted on the full frame, so a cell
+// (-p) traces the frame's paths and keeps its own splats (it renders exactly its window of the
+// full frame), and a share of sample indices (set_sample_range) its share of light paths.
+uint64_t RenderSession::light_paths_for(uint64_t samples) const {
+  const double frame = double(m_params.width) * m_params.height;
+  const double scene = m_scene_pixels >= 0 ? m_scene_pixels : frame;
+  const double per_sample = std::min(kMaxLightPathsPerSample * frame, kLightPathsPerScenePixel * scene);
+  return uint64_t(std::ceil(per_sample * double(samples)));
+}
+
+void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) {
+  uint64_t want = light_paths_for(uint64_t(m_first_sample) + uint64_t(target));
+  if (want <= m_lt_issued) return;
+  m_film.begin_light_paths();
+  // Chunks of paths run on the threads in waves; each wave's splats are merged in path order before
+  // the next, which bounds the memory they take whatever the pass's size.
+  constexpr uint64_t kChunk = 1024, kWave = 64;
+  const uint64_t first = m_lt_issued, count = want - first;
+  m_lt_issued = want;  // paths of a cancelled chunk are skipped, not retried: they stay independent
+  const uint64_t chunks = (count + kChunk - 1) / kChunk;
+  std::vector<std::vector<CausticSplat>> splats(size_t(std::min(chunks, kWave)));
+  std::vector<uint8_t> finished(splats.size());
+  for (uint64_t wave = 0; wave < chunks && !stop_requested(cancel); wave += kWave) {
+    const size_t in_wave = size_t(std::min(kWave, chunks - wave));
+    for (auto& s : splats) s.clear();
+    std::fill(finished.begin(), finished.end(), 0);
+    std::atomic<size_t> next{0};
+    auto worker = [&]() {
+      const uint64_t cpu_start = thread_cpu_ns();
+      uint64_t rays = 0;
+      for (size_t c; (c = next.fetch_add(1)) < in_wave && !stop_requested(cancel);) {
+        uint64_t b = first + (wave + c) * kChunk, e = std::min(first + count, b + kChunk);
+        trace_caustic_paths(m_scene, m_params, m_caustic_film, b, e - b, splats[c], rays);
+        finished[c] = 1;
+      }
+      m_rays += rays;
+      m_cpu_ns += thread_cpu_ns() - cpu_start;
+    };
+    int nthreads = std::max(1, std::min<int>(m_params.threads, int(in_wave)));
+    std::vector<std::thread> pool;
+    for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    for (size_t c = 0; c < in_wave; ++c) {
+      if (!finished[c]) continue;
+      m_film.add_splats(splats[c]);
+      m_film.add_light_paths(std::min(kChunk, count - (wave + c) * kChunk));
+    }
+  }
+}
+
+bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel, const TileCallback& on_tile) {
+  target_spp = std::min(target_spp, m_params.spp);
+  auto start = std::chrono::steady_clock::now();
+  m_film.invalidate_estimate();
+  if (m_caustics_light_traced) trace_caustics(target_spp, cancel);
+  std::atomic<size_t> next{0};
+  auto worker = [&]() {
+    const uint64_t cpu_start = thread_cpu_ns();
+    uint64_t rays = 0, samples = 0, nonfinite = 0;
+    for (;;) {
+      const size_t k = next.fetch_add(1);
+      if (k >= m_tile_order.size()) break;
+      if (stop_requested(cancel)) break;
+      const uint32_t ti = m_tile_order[k];
+      const auto t0 = std::chrono::steady_clock::now();
+      render_tile(m_tiles[ti], target_spp, cancel, rays, samples, nonfinite);
+      m_tile_ns[ti] = uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count());
+      if (on_tile && !stop_requested(cancel)) on_tile(m_tiles[ti]);
+    }
+    m_rays += rays;
+    m_samples += samples;
+    m_nonfinite += nonfinite;
+    m_cpu_ns += thread_cpu_ns() - cpu_start;
+  };
+  int nthreads = std::max(1, std::min<int>(m_params.threads, int(m_tiles.size())));
+  std::vector<std::thread> pool;
+  for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  order_tiles_by_cost();
+  m_film.invalidate_estimate();  // also for an estimate someone asked for while the pass ran
+  m_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ++m_passes;
+  return !stop_requested(cancel);
+}
+
+bool RenderSession::render_all(const std::atomic<bool>* cancel, const std::function<void()>& on_progress) {
+  TileCallback tiles = on_progress ? TileCallback([&](const Tile&) { on_progress(); }) : TileCallback();
+  return run_progressive(*this, RunLimits(), cancel, tiles) == StopReason::finished;
+}
+
+FilmPass render_film_pass(const RenderScene& scene, const RenderParams& params, uint32_t first, uint32_t count,
+                          const std::vector<uint8_t>& skip, const std::atomic<bool>* cancel, bool* complete) {
+  RenderParams p = params;
+  p.adaptive = false;  // convergence is judged on the merged statistics, not per pass
+  RenderSession session(scene, p);
+  session.set_sample_range(first, skip);
+  bool ok = session.render_pass(int(count), cancel);
+  if (complete) *complete = ok;
+  FilmPass out = session.film().to_pass(first, count);
+  SessionStats st = session.stats();
+  out.rays = st.rays;
+  out.nonfinite = st.nonfinite;
+  out.seconds = st.seconds;
+  return out;
+}
+
+double RenderSession::progress() const {
+  double total = double(m_params.spp) * double(m_film.pixels());
+  return total > 0 ? std::min(1.0, double(m_budget_done.load()) / total) : 1.0;
+}
+
+void RenderSession::set_sample_range(uint32_t first, const std::vector<uint8_t>& skip) {
+  m_first_sample = first;
+  if (m_caustics_light_traced) m_lt_issued = light_paths_for(first);
+  m_film.skip(skip);
+}
+
+SessionStats RenderSession::stats() const {
+  SessionStats s;
+  s.samples = m_samples.load();
+  s.rays = m_rays.load();
+  s.nonfinite = m_nonfinite.load();
+  s.light_paths = m_film.light_paths();
+  s.seconds = m_seconds;
+  s.cpu_seconds = double(m_cpu_ns.load()) * 1e-9;
+  s.passes = m_passes;
+  return s;
+}
+
+}  // namespace pt

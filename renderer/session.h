@@ -1,0 +1,149 @@
+// The render session: one progressive, cancellable render of a RenderScene into a Film, in passes
+// of tiles on the render threads (session.cpp), each tile's samples by the path loop (session_tile.cpp).
+// It is a PassSource: the driver (driver.h) decides the passes and when to stop.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+#include "caustics.h"
+#include "driver.h"
+#include "film.h"
+#include "film_pass.h"
+#include "integrator.h"
+#include "render_scene.h"
+
+namespace pt {
+
+struct SessionStats {
+  uint64_t samples = 0, rays = 0, nonfinite = 0;
+  uint64_t light_paths = 0;  // caustic light paths traced (caustics.h)
+  double seconds = 0;
+  // CPU time the render threads spent in passes, summed over threads: against threads x seconds it
+  // tells a slow host (threads that waited for a core) from a slow render (bench_scaling).
+  double cpu_seconds = 0;
+  int passes = 0;
+};
+
+// The film's adaptive rule as the options set it.
+AdaptiveRule adaptive_rule(const RenderParams& params);
+
+class RenderSession : public PassSource {
+ public:
+  RenderSession(const RenderScene& scene, const RenderParams& params);
+
+  // Advances every unfinished pixel to `target_spp` samples (adaptive pixels may stop early).
+  // `on_tile` runs on worker threads after each finished tile. Returns false if cancelled or past
+  // the deadline.
+  bool render_pass(int target_spp, const std::atomic<bool>* cancel = nullptr, const TileCallback& on_tile = {});
+  // Renders passes of doubling size up to params.spp (run_progressive without limits); `on_progress`
+  // after each tile. True when it finished.
+  bool render_all(const std::atomic<bool>* cancel = nullptr, const std::function<void()>& on_progress = {});
+
+  // PassSource
+  bool advance(int target_spp, const std::atomic<bool>* cancel, const TileCallback& on_tile) override {
+    return render_pass(target_spp, cancel, on_tile);
+  }
+  void set_deadline(std::chrono::steady_clock::time_point t) override { m_deadline = t; }
+  const Film& film() const override { return m_film; }
+  double seconds() const override { return m_seconds; }
+  // Estimated relative MSE of the image (Film::error_estimate), on the render threads.
+  double error_estimate() const override { return m_film.error_estimate(m_params.threads); }
+  bool finished() const override { return m_film.finished(); }
+
+  const RenderParams& params() const { return m_params; }
+  const RenderScene& scene() const { return m_scene; }
+  int width() const { return m_film.width(); }
+  int height() const { return m_film.height(); }
+  // Fraction of the sample budget done (converged pixels count as complete); safe during a pass.
+  double progress() const;
+  ImageRGB image() const { return m_film.image(); }
+  ImageRGB rate_image() const { return m_film.rate_image(); }
+  SessionStats stats() const;
+  const std::vector<Tile>& tiles() const { return m_tiles; }
+
+  // For one share of a distributed render: sample indices start at `first` (so disjoint ranges
+  // merge into the single-machine image; the caustic light paths follow the same share) and pixels
+  // whose `skip` byte is set are left out. Call before the first pass.
+  void set_sample_range(uint32_t first, const std::vector<uint8_t>& skip);
+  // True when every camera ray of frame pixel (fx, fy_up) (y up, as the course counts rows) misses
+  // the scene, so that its samples are black without a ray query (see find_scene_rectangle).
+  bool sees_only_background(int fx, int fy_up) const {
+    if (!m_background_rect) return false;
+    int x = fx - m_frame_x0, y = (m_params.height - 1 - fy_up) - m_frame_y0;
+    if (!m_background.empty() && x >= 0 && y >= 0 && x < width() && y < height())
+      return m_background[size_t(y) * width() + x];
+    return outside_scene_rectangle(fx, fy_up);
+  }
+  // Objects whose own projected rectangles refine the scene's (find_scene_rectangle).
+  static constexpr size_t kMaxMaskedObjects = 256;
+
+ private:
+  void find_scene_rectangle();
+  void order_tiles_by_cost();  // m_tile_order from m_tile_ns, ties in raster order
+  bool outside_scene_rectangle(int fx, int fy_up) const { return outside_scene_columns(fx) || outside_scene_rows(fy_up); }
+  bool outside_scene_columns(int fx) const { return fx + 1 < m_scene_u0 || fx > m_scene_u1; }
+  bool outside_scene_rows(int fy_up) const { return fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1; }
+  // sees_only_background for film pixel i = y width + x, from the mask where there is one (the tile
+  // loops ask once per pixel and pass).
+  bool background_pixel(size_t i, int x, int y) const {
+    if (!m_background.empty()) return m_background[i] != 0;
+    return sees_only_background(m_frame_x0 + x, m_params.height - 1 - (m_frame_y0 + y));
+  }
+  void trace_caustics(int target_spp, const std::atomic<bool>* cancel);
+  uint64_t light_paths_for(uint64_t samples) const;
+  // session_tile.cpp: a tile's samples up to target_spp, path by path or in packets.
+  void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
+                   uint64_t& samples, uint64_t& nonfinite);
+  void render_tile_batched(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
+                           uint64_t& samples, uint64_t& nonfinite, PathBatchTracer trace);
+  // The pixel sample's point on the sensor (its jitter draw), and its camera ray (+ the lens draw).
+  Vec2 sensor_sample(int fx, int fy_up, Sampler& rng) const;
+  void camera_ray(int fx, int fy_up, Sampler& rng, Ray& r) const;
+
+  const RenderScene& m_scene;
+  RenderParams m_params;
+  int m_frame_x0, m_frame_y0;  // film origin inside the full frame, top-left
+  // Caustics by light tracing (caustics.h): its light tracer renders the caustic paths, so the path
+  // loop leaves them out.
+  bool m_caustics_light_traced;
+  Film m_film;
+  // Pixels whose every camera ray misses the scene (frame pixel coordinates, y up): outside this
+  // rectangle a sample is black and costs no ray query. Off (empty) for a visible environment.
+  bool m_background_rect = false;
+  float m_scene_u0 = 0, m_scene_u1 = 0, m_scene_v0 = 0, m_scene_v1 = 0;
+  double m_scene_pixels = -1;  // the projected bounds' area within the full frame (-1: unknown)
+  // Film pixels that see only background: outside the rectangle, or inside it where no object's
+  // own rectangle reaches. Empty without a rectangle, or for films over 2^24 pixels (the
+  // rectangle alone decides there).
+  std::vector<uint8_t> m_background;
+  uint32_t m_first_sample = 0;
+  std::vector<Tile> m_tiles;
+  // The order threads take tiles in: the costliest first (the last pass's time, at first the
+  // pixels that see the scene), so that the pass does not end waiting on one thread's last big
+  // tile (longest-processing-time-first; R. L. Graham, "Bounds on multiprocessing timing
+  // anomalies", SIAM J. Appl. Math. 17, 1969). The image does not depend on the order.
+  std::vector<uint32_t> m_tile_order;
+  std::vector<uint64_t> m_tile_ns;  // each tile's render time in the last pass that reached it
+  CausticFilm m_caustic_film;
+  uint64_t m_lt_issued = 0;  // light paths issued (a cancelled chunk's are skipped, not retried)
+  std::atomic<uint64_t> m_samples{0}, m_rays{0}, m_nonfinite{0};
+  std::atomic<uint64_t> m_budget_done{0};  // pixel-samples done, converged pixels counted in full
+  std::atomic<uint64_t> m_cpu_ns{0};      // SessionStats::cpu_seconds
+  double m_seconds = 0;
+  int m_passes = 0;
+  std::chrono::steady_clock::time_point m_deadline = std::chrono::steady_clock::time_point::max();
+  bool stop_requested(const std::atomic<bool>* cancel) const {
+    return (cancel && cancel->load(std::memory_order_relaxed)) || std::chrono::steady_clock::now() >= m_deadline;
+  }
+};
+
+// Renders one pass for a share of a distributed render (set_sample_range) and returns its sums.
+// `skip` (one byte per pixel, may be empty) marks converged pixels; `cancel` stops early (the pass
+// then holds what was done and comes back marked incomplete).
+FilmPass render_film_pass(const RenderScene& scene, const RenderParams& params, uint32_t first, uint32_t count,
+                          const std::vector<uint8_t>& skip, const std::atomic<bool>* cancel, bool* complete = nullptr);
+
+}  // namespace pt
