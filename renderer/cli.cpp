@@ -162,7 +162,7 @@ std::string usage_text(const std::string& program) {
 "                        and draw their samples one at a time instead of eight in AVX2 lanes\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"
 "\n"
-"Error against run time (with -f; the window honours --target-error only):\n"
+"Error against run time (--error-log and --reference with -f; the window honours the two limits):\n"
 "  --error-log <FILE>     write one CSV row per pass: seconds, spp, error estimate (+ true error)\n"
 "  --target-error <X>     stop once the estimated relative MSE is <= X\n"
 "  --time-limit <SEC>     stop after SEC seconds of rendering\n"

@@ -233,6 +233,20 @@ TEST_F(Viewer, TheErrorTargetEndsTheRender) {
   EXPECT_NE(title.find(std::string(m[1]) + "/65536 spp done"), std::string::npos) << title;
 }
 
+// --time-limit ends the window's render as it ends a file render (the same driver): the pass it
+// cuts short is the last, the title says done, and the budget is far from spent.
+TEST_F(Viewer, TheTimeLimitEndsTheRender) {
+  RunResult r = run_window("-t 2 -s 65536 -m 3 -r 64 48 --no-adaptive --time-limit 0.5", "wait_spp 65536\ntitle\nquit\n");
+  const std::string& o = r.output;
+  const std::string pass = last_line_with(o, "pass: ");
+  EXPECT_NE(pass.find("time limit reached"), std::string::npos) << o;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(pass, m, std::regex(R"(pass: (\d+)/65536 spp)"))) << pass;
+  EXPECT_LT(std::stoi(m[1]), 65536) << pass;
+  const std::string title = last_line_with(o, "title: ");
+  EXPECT_NE(title.find(std::string(m[1]) + "/65536 spp done"), std::string::npos) << title;
+}
+
 TEST_F(Viewer, KeysChangeTheSettingsTheyName) {
   RunResult r = run_window("-t 2 -s 4 -m 3 -r 64 48", R"(wait_spp 1
 key .
