@@ -21,8 +21,8 @@ namespace {
 
 // Each run renders a view of one shared base, as the server's jobs do.
 double samples_per_second(const SceneBase& base, RenderParams p, bool generic) {
-  p.generic = generic;
   auto scene = make_view(base, p);
+  if (generic) scene->features.bits = kFeatAll;  // the path loop with every feature
   RenderSession s(*scene, p);
   s.render_all();
   return s.stats().samples / s.stats().seconds;

@@ -250,7 +250,7 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
 void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
                          uint64_t first, uint64_t count, std::vector<CausticSplat>& out, uint64_t& rays) {
   // A pool of paths advances a vertex at a time, their rays traced together (Embree packets
-  // unless --no-ray-packets), then their camera connections. Splats are kept in path order, as
+  // unless LoopForms::packets is off), then their camera connections. Splats are kept in path order, as
   // one path after another would make them, so the image does not depend on the pool.
   constexpr size_t kSlots = 256;
   struct Pending {
@@ -275,7 +275,7 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
     const size_t m = paths.size();
     if (m == 0) break;
     rays += m;
-    if (params.ray_packets) {  // the rays where they lie in the paths, not copied out
+    if (scene.loop.packets) {  // the rays where they lie in the paths, not copied out
       scene.accel->intersect_many(&paths[0].ray, sizeof(LightPath), m, hits.data(), found.data());
     } else {
       for (size_t i = 0; i < m; ++i) found[i] = scene.accel->intersect(paths[i].ray, hits[i]);
@@ -297,7 +297,7 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
     paths.erase(paths.begin() + ptrdiff_t(live), paths.end());
     blocked.resize(shadows.size());
     rays += shadows.size();
-    if (params.ray_packets) {
+    if (scene.loop.packets) {
       scene.accel->occluded_many(shadows.data(), shadows.size(), blocked.data());
     } else {
       for (size_t k = 0; k < shadows.size(); ++k) blocked[k] = scene.accel->occluded(shadows[k]);

@@ -85,10 +85,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "-h" || a == "--help") { o.help = true; }
     else if (a == "--no-adaptive") { p.adaptive = false; }
     else if (a == "--keep-fov") { p.keep_fov = true; }
-    else if (a == "--generic") { p.generic = true; }
     else if (a == "--no-caustic-tracing") { p.caustic_tracing = false; }
-    else if (a == "--no-ray-packets") { p.ray_packets = false; }
-    else if (a == "--no-simd-lanes") { p.simd_lanes = false; }
     else if (a == "--sampler") {
       need(a, 1);
       std::string v = args[++i];
@@ -155,11 +152,7 @@ std::string usage_text(const std::string& program) {
 "  --quiet         no progress bar\n"
 "  --keep-fov      -r scales the course's 800x600 view to the output size instead of cropping it\n"
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
-"  --generic       run the path loop with every feature (for comparisons with the specialised one)\n"
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
-"  --no-ray-packets      trace camera paths one at a time instead of many in Embree packets\n"
-"  --no-simd-lanes       shade packets' diffuse vertices one at a time instead of four in SSE2 lanes,\n"
-"                        and draw their samples one at a time instead of eight in AVX2 lanes\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"
 "\n"
 "Error against run time (--error-log and --reference with -f; the window honours the two limits):\n"
@@ -206,7 +199,7 @@ Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
   Metadata run{{"pathtracer:achieved_spp", num(pixels > 0 ? st.samples / pixels : 0)},
                {"pathtracer:direct", p.hemisphere ? "hemisphere" : "light sampling"},
                {"pathtracer:ray_packets",
-                p.ray_packets && !p.hemisphere ? std::to_string(session.scene().accel->packet_width()) : "off"},
+                packets_apply(session.scene(), p) ? std::to_string(session.scene().accel->packet_width()) : "off"},
                {"pathtracer:caustic_light_paths", std::to_string(st.light_paths)},
                {"pathtracer:environment", p.env_map},
                {"pathtracer:threads", std::to_string(p.threads)},

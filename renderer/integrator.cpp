@@ -309,9 +309,9 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
   // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
   // for all vertices at once: each sampler still sees its own draws in that order.
   for (size_t l = 0; l < nl; ++l)  // light sample l of every vertex: u_light[l n, (l + 1) n)
-    Sampler::next_2d_many(samplers.data(), size_t(n), u_light.data() + l * size_t(n), params.simd_lanes);
+    Sampler::next_2d_many(samplers.data(), size_t(n), u_light.data() + l * size_t(n), scene.loop.lanes);
   for (Sampler* rng : samplers) rng->skip_1d();
-  Sampler::next_2d_many(samplers.data(), size_t(n), u.data(), params.simd_lanes);
+  Sampler::next_2d_many(samplers.data(), size_t(n), u.data(), scene.loop.lanes);
   for (int j = 0; j < padded; ++j) {
     const uint32_t i = which[j < n ? j : 0];  // padding lanes repeat the first vertex
     PathState& st = slots[i].st;
@@ -476,7 +476,7 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
 }  // namespace
 
 bool diffuse_lanes_apply(const RenderScene& scene, const RenderParams& params) {
-  if (!params.simd_lanes || params.hemisphere || params.light_samples < 1) return false;
+  if (!scene.loop.lanes || params.hemisphere || params.light_samples < 1) return false;
   for (const Light& light : scene.lights)  // the lanes know no other light
     if (light.kind != LightKind::rect && light.kind != LightKind::mesh) return false;
   return true;

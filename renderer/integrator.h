@@ -20,11 +20,15 @@ PathTracer path_tracer_for(uint32_t feature_bits);
 using PathBatchTracer = void (*)(const RenderScene&, const RenderParams&, const Ray* camera_rays, class Sampler* rngs,
                                  size_t n, Vec3* out, uint64_t& rays);
 PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const RenderParams& params);
-// Whether the batched loop takes its diffuse vertices four at a time in SSE2 lanes
-// (diffuse_lanes.h): packets, every light an area light (rectangle or mesh), and not --no-simd-lanes.
+// Whether the batched loop takes its diffuse vertices in SIMD lanes (diffuse_lanes.h): lanes on
+// (LoopForms), every light an area light (rectangle or mesh), light sampling (not -H).
 bool diffuse_lanes_apply(const RenderScene& scene, const RenderParams& params);
 // Whether packets take their Sobol draws eight at a time (Sampler::next_2d_many / sobol_draws):
-// the Sobol sampler, lanes not turned off, and a CPU with AVX2.
-bool sobol_draws_in_lanes(const RenderParams& params);
+// the Sobol sampler, lanes on, and a CPU with AVX2.
+bool sobol_draws_in_lanes(const RenderScene& scene, const RenderParams& params);
+// Whether the session traces camera paths in packets (LoopForms::packets, and not -H).
+inline bool packets_apply(const RenderScene& scene, const RenderParams& params) {
+  return scene.loop.packets && !params.hemisphere;
+}
 
 }  // namespace pt

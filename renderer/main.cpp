@@ -51,7 +51,7 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
               f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
-  const bool packets = o.params.ray_packets && !o.params.hemisphere;
+  const bool packets = packets_apply(scene, o.params);
   if (packets) std::printf("ray queries:      paths in Embree packets of %d\n", scene.accel->packet_width());
   else std::printf("ray queries:      one path at a time\n");
   const char* diffuse = !(packets && diffuse_lanes_apply(scene, o.params)) ? "one at a time"
@@ -59,7 +59,7 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
                                                                           : "four at a time (SSE2 lanes)";
   std::printf("diffuse vertices: %s\n", diffuse);
   std::printf("sample draws:     %s\n",
-              packets && sobol_draws_in_lanes(o.params) ? "eight at a time (AVX2 lanes)" : "one at a time");
+              packets && sobol_draws_in_lanes(scene, o.params) ? "eight at a time (AVX2 lanes)" : "one at a time");
   std::printf("render memory:    %.2f MiB (%.1f bytes per primitive: BVH, vertices, indices, shading data)\n",
               bytes / 1048576.0, prims ? double(bytes) / prims : 0.0);
   std::printf("load + build:     %.3f s\n", load_s);

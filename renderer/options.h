@@ -32,9 +32,6 @@ struct RenderParams {
   int cell_x = 0, cell_y = 0, cell_w = 0, cell_h = 0;  // -p: window, bottom-left origin; w = 0: full frame
   uint64_t seed = 0;               // --seed
   int tile_size = 32;
-  bool generic = false;            // --generic: the path loop with every feature (for comparisons)
-  bool ray_packets = true;         // --no-ray-packets: trace paths one at a time, not in Embree packets
-  bool simd_lanes = true;          // --no-simd-lanes: packets' diffuse vertices and sample draws one at a time
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
   bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
   // Set by RenderSession, not by users: its light tracer renders the caustic paths (caustics.h),

@@ -247,7 +247,6 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
   f.adaptive = params.adaptive && params.spp > params.adaptive_batch;
   f.caustic_tracing = caustic_tracing_applies(*rs, params);
   if (!rs->infinite_lights.empty()) f.bits |= kFeatInfinite;
-  if (params.generic) f.bits = kFeatAll;
   return rs;
 }
 

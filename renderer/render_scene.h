@@ -53,7 +53,15 @@ struct SceneBase {
   size_t memory_bytes() const;
 };
 
+// The forms the path loop runs in. Users always get the defaults; tests and benchmarks turn them
+// off on a view to compare the forms, which render the same images.
+struct LoopForms {
+  bool packets = true;  // camera paths many at once, their rays in Embree packets (-H: never)
+  bool lanes = true;    // packets' diffuse vertices and sample draws in SIMD lanes
+};
+
 struct RenderScene {
+  LoopForms loop;
   std::vector<Material> materials;
   std::vector<Light> lights;
   std::vector<int> infinite_lights;  // ambient / environment, looked up when rays escape

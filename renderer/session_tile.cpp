@@ -6,8 +6,8 @@
 
 namespace pt {
 
-bool sobol_draws_in_lanes(const RenderParams& params) {
-  return params.simd_lanes && params.sampler == SamplerKind::sobol && Sampler::lanes_available();
+bool sobol_draws_in_lanes(const RenderScene& scene, const RenderParams& params) {
+  return scene.loop.lanes && params.sampler == SamplerKind::sobol && Sampler::lanes_available();
 }
 
 Vec2 RenderSession::sensor_sample(int fx, int fy_up, Sampler& rng) const {
@@ -27,7 +27,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
                                 uint64_t& samples, uint64_t& nonfinite) {
   const RenderParams& p = m_params;
   const int w = width();
-  if (p.ray_packets) {
+  if (packets_apply(m_scene, p)) {
     if (PathBatchTracer many = path_batch_tracer_for(m_scene.features.bits, p)) {
       render_tile_batched(t, target, cancel, rays, samples, nonfinite, many);
       return;
@@ -84,7 +84,7 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   const bool lens = m_scene.camera.lens_radius > 0;
   // With Sobol draws in lanes, the camera's draws come from each job's pixel base and sample index
   // (Sampler::sobol_draws), and its sampler starts past them.
-  const bool sobol_lanes = sobol_draws_in_lanes(p);
+  const bool sobol_lanes = sobol_draws_in_lanes(m_scene, p);
   const uint32_t camera_draws = (p.spp == 1 ? 0 : 1) + (lens ? 1 : 0);
   // The batch's arrays, kept on the thread from tile to tile: allocated per tile they cost some
   // 150 KB of fresh pages each time, about 5 ms of a pass (dof, 16 spp).
@@ -126,14 +126,14 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     } else if (sobol_lanes) {
       Sampler::sobol_draws(job_base.data(), job_sample.data(), n, 1, draws.data());
     } else {
-      Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
+      Sampler::next_2d_many(rngs.data(), n, draws.data(), m_scene.loop.lanes);
     }
     for (size_t k = 0; k < n; ++k) {
       sensor_x[k] = (sensor_x[k] + draws[k].x) / float(p.width);
       sensor_y[k] = (sensor_y[k] + draws[k].y) / float(p.height);
     }
     if (lens && sobol_lanes) Sampler::sobol_draws(job_base.data(), job_sample.data(), n, camera_draws, draws.data());
-    else if (lens) Sampler::next_2d_many(rngs.data(), n, draws.data(), p.simd_lanes);
+    else if (lens) Sampler::next_2d_many(rngs.data(), n, draws.data(), m_scene.loop.lanes);
     if (camera_rays.size() < n) camera_rays.resize(n);  // kept between flushes: no zeroing
     m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
     out.resize(n);

@@ -165,8 +165,8 @@ TEST(Caustics, SameImageAtAnyThreadCount) {
 TEST(Caustics, PooledLightPathsSplatAsOnePathAtATime) {
   SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
   RenderParams p = cornell_params();
-  p.ray_packets = false;
   auto scene = make_render_scene(desc, p);
+  scene->loop.packets = false;
   ASSERT_TRUE(scene->features.caustic_tracing);
   const CausticFilm film{p.width, p.height, 0, 0, p.width, p.height};
   std::vector<CausticSplat> pooled, single;

@@ -146,7 +146,7 @@ TEST(Cli, HelpDocumentsEveryFlag) {
   RunResult r = run("--help");
   EXPECT_EQ(r.status, 0);
   for (const char* f : {"-s ", "-l ", "-t ", "-m ", "-e ", "-b ", "-d ", "-f ", "-r ", "-c ", "-a ", "-p ", "-H ",
-                        "-h", "--file-camera", "--seed", "--no-adaptive", "--no-caustic-tracing", "--no-ray-packets"})
+                        "-h", "--file-camera", "--seed", "--no-adaptive", "--no-caustic-tracing", "--sampler", "--describe"})
     EXPECT_NE(r.output.find(f), std::string::npos) << f;
 }
 
@@ -184,7 +184,7 @@ TEST(Cli, RendersPngRateImageAndExrWithMetadata) {
   RunResult described = run("--describe " + scene);
   ASSERT_TRUE(std::regex_search(described.output, width, std::regex("Embree packets of ([0-9]+)"))) << described.output;
   EXPECT_EQ(in->spec().get_string_attribute("pathtracer:ray_packets"), width[1].str());
-  r = run("-s 4 -m 2 -r 64 48 --no-ray-packets --quiet -f " + dir + "/single.exr " + scene);
+  r = run("-s 4 -m 2 -r 64 48 -H --quiet -f " + dir + "/single.exr " + scene);  // -H casts one ray at a time
   ASSERT_EQ(r.status, 0) << r.output;
   in = OIIO::ImageInput::open(dir + "/single.exr");
   ASSERT_TRUE(in);
@@ -269,13 +269,15 @@ TEST(Cli, DescribePrintsTheFeatureSetAndMemory) {
       << r.output;
   r = run("-s 16 -m 5 --describe " + test::own_scene("cornell.dae"));
   EXPECT_NE(r.output.find("caustics:         light traced"), std::string::npos) << r.output;
-  r = run("--describe --generic " + test::own_scene("cornell.dae"));
-  EXPECT_NE(r.output.find("path loop:        generic"), std::string::npos) << r.output;
+  r = run("--describe " + test::own_scene("cornell.dae"));
+  EXPECT_NE(r.output.find("path loop:        specialised: delta no-microfacet no-infinite-lights"), std::string::npos)
+      << r.output;
   // Embree's native packet width: 16 with AVX-512, 8 below it.
   EXPECT_TRUE(std::regex_search(r.output, std::regex("ray queries:      paths in Embree packets of (8|16)\n")))
       << r.output;
-  r = run("--describe --no-ray-packets " + test::own_scene("cornell.dae"));
-  EXPECT_NE(r.output.find("ray queries:      one path at a time"), std::string::npos) << r.output;
+  r = run("--describe --no-ray-packets " + test::own_scene("cornell.dae"));  // an experiment's switch, gone
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("--no-ray-packets"), std::string::npos) << r.output;
   r = run("--describe -H " + test::own_scene("cornell.dae"));  // its direct-light rays go one at a time
   EXPECT_NE(r.output.find("ray queries:      one path at a time"), std::string::npos) << r.output;
   r = run("-s 16 -m 5 --describe --no-caustic-tracing " + test::own_scene("cornell.dae"));

@@ -213,10 +213,10 @@ TEST(ErrorEstimateBackground, AFrameOfBackgroundOnlyIsConvergedFromTwoSamples) {
       p.height = 16;
       p.adaptive = false;
       p.spp = 16;
-      p.ray_packets = packets;
       p.lens_radius = lens;
       p.focal_distance = 2;
       auto scene = make_render_scene(d, p);
+      scene->loop.packets = packets;
       RenderSession s(*scene, p);
       for (int fy = 0; fy < p.height; ++fy)
         for (int fx = 0; fx < p.width; ++fx) ASSERT_TRUE(s.sees_only_background(fx, fy)) << fx << " " << fy;

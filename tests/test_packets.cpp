@@ -76,8 +76,9 @@ TEST(Packets, BatchedPathsRenderWhatThePathByPathLoopRenders) {
     ASSERT_NE(path_batch_tracer_for(scene->features.bits, p), nullptr);
     RenderSession batched(*scene, p);
     batched.render_all();
-    p.ray_packets = false;
-    RenderSession single(*scene, p);
+    RenderScene one_by_one = *scene;
+    one_by_one.loop.packets = false;
+    RenderSession single(one_by_one, p);
     single.render_all();
     ImageRGB a = batched.image(), b = single.image();
     ASSERT_EQ(a.pixels.size(), b.pixels.size());
@@ -106,10 +107,10 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
     RenderParams p = c.params;
     auto scene = make_render_scene(desc, p);
     laned += diffuse_lanes_apply(*scene, p);
-    RenderParams one = p;
-    one.simd_lanes = false;
-    EXPECT_FALSE(diffuse_lanes_apply(*scene, one));
-    RenderSession without(*scene, one);
+    RenderScene scalar = *scene;
+    scalar.loop.lanes = false;
+    EXPECT_FALSE(diffuse_lanes_apply(scalar, p));
+    RenderSession without(scalar, p);
     without.render_all();
     test::AllowAvx2Afterwards restore;
     for (bool avx2 : {true, false}) {  // eight lanes where the CPU has AVX2, and four (SSE2)

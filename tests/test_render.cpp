@@ -371,9 +371,9 @@ TEST(Adaptive, ProgressCountsStoppedPixelsAsDone) {
     p.max_depth = 1;
     p.spp = 256;
     p.adaptive_batch = 32;
-    p.ray_packets = packets;
     p.adaptive = false;
     auto scene = make_render_scene(desc, p);
+    scene->loop.packets = packets;
     RenderSession fixed(*scene, p);
     for (int target : {1, 16, 64}) {
       fixed.render_pass(target);
