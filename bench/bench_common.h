@@ -1,4 +1,4 @@
-// What the error-vs-time benchmarks (convergence, ceiling, scaling) share: the scene list, the
+// What the error-vs-time benchmarks (convergence, scaling) share: the scene list, the
 // render settings of the comparison framing, medians (flags: args.h).
 #pragma once
 

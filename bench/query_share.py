@@ -1,10 +1,8 @@
 """The share of a render's CPU time spent in ray queries, by `perf` sampling (vs_mitsuba.py --profile).
 
-A path tracer's rays/s over the raw Embree ceiling for the same rays (bench_ceiling's PT/raw) is
-about its share of time in ray queries over the raw replay's own share (about 0.9: the replay
-packs its packets too), where the pass's queries cost what the replay's do. Mitsuba 3 has no
-replay of its rays, but `perf` measures its share, and ours the same way, so the two renderers
-compare on the same host in the same run.
+The rest of the time is each renderer's own work around its queries (hit refinement, shading,
+sampling): (1 - share) / share is that work per unit of query time. `perf` measures Mitsuba 3 and
+ours the same way, so the two renderers compare on the same host in the same run.
 
 A ray query is Embree's own code plus the intersection callbacks of the shapes it calls back (our
 sphere user geometry; Mitsuba's sphere and rectangle plugins' `ray_intersect_preliminary` and

@@ -17,8 +17,8 @@ and the two references are compared with each other to check that the conversion
 Timings exclude start-up: Mitsuba's kernel compilation (one warm-up render) and our scene load.
 --ours adds flags to our timed runs only (the reference keeps the defaults): flags that change how
 we sample, not what converges, such as --no-caustic-tracing (unidirectional path tracing, as
-Mitsuba's `path` does) or --no-ray-packets. --profile also prints each renderer's share of time in
-ray queries, measured with perf (query_share.py), which sets its rays/s over the raw ceiling.
+Mitsuba's `path` does). --profile also prints each renderer's share of time in ray queries (Embree
+and the intersection callbacks it calls), measured with perf (query_share.py).
 """
 import argparse
 import json
@@ -278,7 +278,7 @@ def main():
 
 
 def verdict(what, goal, cases):
-    """Issue 6's target against this run, as bench_ceiling and bench_scaling print theirs (bench_common.h):
+    """Issue 6's target against this run, as bench_scaling and bench_convergence print theirs (bench_common.h):
     met or not, the weakest case, and how many miss; ratios compare as printed, to two decimals."""
     if not cases:
         return f"target: {what}: nothing measured"

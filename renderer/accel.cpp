@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstddef>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -16,7 +15,6 @@
 #include <vector>
 
 #include "accel_math.h"
-#include "accel_probe.h"
 
 namespace pt {
 
@@ -334,18 +332,6 @@ struct Packet<16> {
   static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(valid, s, c, r); }
 };
 
-// The packet calls as Accel makes them: timed for the benchmarks' probe (accel_probe.h).
-template <int K>
-void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, typename Packet<K>::RayHit* r) {
-  probe::TimeInto timed(&AccelTimer::embree);
-  Packet<K>::intersect(valid, s, c, r);
-}
-template <int K>
-void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, typename Packet<K>::Ray* r) {
-  probe::TimeInto timed(&AccelTimer::embree);
-  Packet<K>::occluded(valid, s, c, r);
-}
-
 // One packet lane from a ray.
 template <class RayK>
 inline void to_lane(const Ray& r, RayK& e, int k) {
@@ -390,58 +376,6 @@ struct Lanes {
   }
 };
 
-}  // namespace
-
-bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
-  probe::record(ray, 0);
-  if (!embree_accepts(ray)) return false;
-  const Impl& a = *m_impl;
-  if (a.cull && !may_hit_bounds(ray, a.lo, a.hi)) return false;
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  to_embree(ray, rh.ray);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  {
-    probe::TimeInto timed(&AccelTimer::embree);
-    rtcIntersect1(m_impl->scene, &ctx, &rh);
-  }
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  probe::TimeInto timed(&AccelTimer::refine);
-  refine_hit(a.geoms[rh.hit.geomID], ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v,
-             [&] { return Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z); }, hit);
-  return true;
-}
-
-namespace {
-
-template <int K>
-void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found);
-template <int K>
-void occluded_packets(const Accel::Impl& a, const Ray* rays, size_t n, uint8_t* blocked);
-
-}  // namespace
-
-void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const {
-  if (m_impl->packet_width == 16) intersect_packets<16>(*m_impl, rays, stride, n, hits, found);
-  else intersect_packets<8>(*m_impl, rays, stride, n, hits, found);
-}
-
-void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {
-  if (m_impl->packet_width == 16) occluded_packets<16>(*m_impl, rays, n, blocked);
-  else occluded_packets<8>(*m_impl, rays, n, blocked);
-}
-
-int Accel::packet_width() const { return m_impl->packet_width; }
-
-void Accel::set_packet_width(int width) {
-  if (width != 8 && width != 16) throw std::invalid_argument("Accel: packet width must be 8 or 16");
-  m_impl->packet_width = width;
-}
-
-namespace {
-
 template <int K>
 void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) {
   RTCIntersectContext ctx;
@@ -452,8 +386,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
   const StridedRays at{reinterpret_cast<const char*>(rays), stride};
   auto trace = [&] {
     lanes.seal(at, rh.ray);
-    intersect_packet<K>(lanes.valid, a.scene, &ctx, &rh);
-    probe::TimeInto timed(&AccelTimer::refine);
+    Packet<K>::intersect(lanes.valid, a.scene, &ctx, &rh);
     for (int k = 0; k < lanes.used; ++k) {
       const uint32_t i = lanes.ray[k];
       if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
@@ -466,7 +399,6 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
   for (size_t i = 0; i < n; ++i) {
     found[i] = 0;
     const Ray& r = at[i];
-    probe::record(r, 0);
     if (!embree_accepts(r) || (a.cull && !may_hit_bounds(r, a.lo, a.hi))) continue;
     rh.hit.geomID[lanes.used] = rh.hit.instID[0][lanes.used] = RTC_INVALID_GEOMETRY_ID;
     if (lanes.add(at, uint32_t(i), rh.ray)) trace();
@@ -483,14 +415,13 @@ void occluded_packets(const Accel::Impl& a, const Ray* rays, size_t n, uint8_t* 
   Lanes<K> lanes;
   auto trace = [&] {
     lanes.seal(rays, rk);
-    occluded_packet<K>(lanes.valid, a.scene, &ctx, &rk);
+    Packet<K>::occluded(lanes.valid, a.scene, &ctx, &rk);
     for (int k = 0; k < lanes.used; ++k) blocked[lanes.ray[k]] = rk.tfar[k] < 0;  // -inf on a hit
     lanes.used = 0;
   };
   for (size_t i = 0; i < n; ++i) {
     blocked[i] = 0;
     const Ray& r = rays[i];
-    probe::record(r, 1);
     if (!embree_accepts(r)) continue;
     if (lanes.add(rays, uint32_t(i), rk)) trace();
   }
@@ -499,163 +430,48 @@ void occluded_packets(const Accel::Impl& a, const Ray* rays, size_t n, uint8_t* 
 
 }  // namespace
 
+bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
+  if (!embree_accepts(ray)) return false;
+  const Impl& a = *m_impl;
+  if (a.cull && !may_hit_bounds(ray, a.lo, a.hi)) return false;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh;
+  to_embree(ray, rh.ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(m_impl->scene, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  refine_hit(a.geoms[rh.hit.geomID], ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v,
+             [&] { return Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z); }, hit);
+  return true;
+}
+
 bool Accel::occluded(const Ray& ray) const {
-  probe::record(ray, 1);
   if (!embree_accepts(ray)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRay r;
   to_embree(ray, r);
-  {
-    probe::TimeInto timed(&AccelTimer::embree);
-    rtcOccluded1(m_impl->scene, &ctx, &r);
-  }
+  rtcOccluded1(m_impl->scene, &ctx, &r);
   return r.tfar < 0;  // Embree sets tfar = -inf on a hit
 }
 
-namespace {
-
-// Packets of K rays of one kind (intersect or shadow) in the order they come.
-template <int K>
-size_t cast_packets(RTCScene scene, RTCIntersectContext& ctx, const Ray* rays, const uint8_t* shadow, size_t n) {
-  alignas(64) typename Packet<K>::RayHit hitsK;
-  alignas(64) typename Packet<K>::Ray shadowsK;
-  set_constant_lanes<K>(hitsK.ray);
-  set_constant_lanes<K>(shadowsK);
-  size_t hits = 0;
-  for (int kind = 0; kind < 2; ++kind) {
-    typename Packet<K>::Ray& rk = kind ? shadowsK : hitsK.ray;
-    Lanes<K> lanes;
-    auto trace = [&] {
-      lanes.seal(rays, rk);
-      if (kind) {
-        occluded_packet<K>(lanes.valid, scene, &ctx, &shadowsK);
-        for (int k = 0; k < lanes.used; ++k) hits += shadowsK.tfar[k] < 0;
-      } else {
-        intersect_packet<K>(lanes.valid, scene, &ctx, &hitsK);
-        for (int k = 0; k < lanes.used; ++k) hits += hitsK.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
-      }
-      lanes.used = 0;
-    };
-    for (size_t i = 0; i < n; ++i) {
-      if (shadow[i] != kind) continue;
-      if (!kind) hitsK.hit.geomID[lanes.used] = hitsK.hit.instID[0][lanes.used] = RTC_INVALID_GEOMETRY_ID;
-      if (lanes.add(rays, uint32_t(i), rk)) trace();
-    }
-    if (lanes.used) trace();
-  }
-  return hits;
+void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const {
+  if (m_impl->packet_width == 16) intersect_packets<16>(*m_impl, rays, stride, n, hits, found);
+  else intersect_packets<8>(*m_impl, rays, stride, n, hits, found);
 }
 
-}  // namespace
-
-// RayPacket16 is RTCRayHit16 field for field (accel.h cannot include Embree).
-static_assert(sizeof(Accel::RayPacket16) == sizeof(RTCRayHit16) && alignof(Accel::RayPacket16) >= 16);
-static_assert(offsetof(Accel::RayPacket16, tfar) == offsetof(RTCRayHit16, ray.tfar));
-static_assert(offsetof(Accel::RayPacket16, flags) == offsetof(RTCRayHit16, ray.flags));
-static_assert(offsetof(Accel::RayPacket16, ngx) == offsetof(RTCRayHit16, hit.Ng_x));
-static_assert(offsetof(Accel::RayPacket16, geom) == offsetof(RTCRayHit16, hit.geomID));
-static_assert(offsetof(Accel::RayPacket16, inst) == offsetof(RTCRayHit16, hit.instID));
-
-namespace {
-void record_packet16(const int* valid, const Accel::RayPacket16& r, uint8_t shadow) {
-  if (__builtin_expect(probe::t_recorder == nullptr, 1)) return;
-  for (int k = 0; k < 16; ++k)
-    if (valid[k]) {
-      Ray ray;
-      ray.o = Vec3(r.ox[k], r.oy[k], r.oz[k]);
-      ray.d = Vec3(r.dx[k], r.dy[k], r.dz[k]);
-      ray.tmin = r.tnear[k];
-      ray.tmax = r.tfar[k];
-      probe::append_ray(ray, shadow);
-    }
-}
-}  // namespace
-
-void Accel::intersect16(const int* valid, RayPacket16& r) const {
-  record_packet16(valid, r, 0);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  intersect_packet<16>(valid, m_impl->scene, &ctx, reinterpret_cast<RTCRayHit16*>(&r));
+void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {
+  if (m_impl->packet_width == 16) occluded_packets<16>(*m_impl, rays, n, blocked);
+  else occluded_packets<8>(*m_impl, rays, n, blocked);
 }
 
-void Accel::occluded16(const int* valid, RayPacket16& r) const {
-  record_packet16(valid, r, 1);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  occluded_packet<16>(valid, m_impl->scene, &ctx, reinterpret_cast<RTCRay16*>(&r));
-}
+int Accel::packet_width() const { return m_impl->packet_width; }
 
-int Accel::light_at(uint32_t geom, uint32_t prim) const {
-  const GeomInfo& g = m_impl->geoms[geom];
-  return g.kind == GeomKind::spheres ? -1 : g.tris[prim].light;
-}
-
-size_t Accel::cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode mode, size_t batch) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);  // incoherent rays, as a path tracer casts them
-  RTCScene scene = m_impl->scene;
-  if (mode == RawMode::packet16) return cast_packets<16>(scene, ctx, rays, shadow, n);
-  if (mode == RawMode::packet8) return cast_packets<8>(scene, ctx, rays, shadow, n);
-  size_t hits = 0;
-  if (mode == RawMode::single || batch <= 1) {
-    for (size_t i = 0; i < n; ++i) {
-      if (shadow[i]) {
-        RTCRay r;
-        to_embree(rays[i], r);
-        {
-          probe::TimeInto timed(&AccelTimer::embree);
-          rtcOccluded1(scene, &ctx, &r);
-        }
-        hits += r.tfar < 0;
-      } else {
-        RTCRayHit rh;
-        to_embree(rays[i], rh.ray);
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        {
-          probe::TimeInto timed(&AccelTimer::embree);
-          rtcIntersect1(scene, &ctx, &rh);
-        }
-        hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-      }
-    }
-    return hits;
-  }
-  std::vector<RTCRayHit> hit_rays(batch);
-  std::vector<RTCRay> shadow_rays(batch);
-  size_t nh = 0, ns = 0;
-  auto flush_hits = [&] {
-    {
-      probe::TimeInto timed(&AccelTimer::embree);
-      rtcIntersect1M(scene, &ctx, hit_rays.data(), unsigned(nh), sizeof(RTCRayHit));
-    }
-    for (size_t k = 0; k < nh; ++k) hits += hit_rays[k].hit.geomID != RTC_INVALID_GEOMETRY_ID;
-    nh = 0;
-  };
-  auto flush_shadows = [&] {
-    {
-      probe::TimeInto timed(&AccelTimer::embree);
-      rtcOccluded1M(scene, &ctx, shadow_rays.data(), unsigned(ns), sizeof(RTCRay));
-    }
-    for (size_t k = 0; k < ns; ++k) hits += shadow_rays[k].tfar < 0;
-    ns = 0;
-  };
-  for (size_t i = 0; i < n; ++i) {
-    if (shadow[i]) {
-      to_embree(rays[i], shadow_rays[ns++]);
-      if (ns == batch) flush_shadows();
-    } else {
-      RTCRayHit& rh = hit_rays[nh++];
-      to_embree(rays[i], rh.ray);
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-      if (nh == batch) flush_hits();
-    }
-  }
-  if (nh) flush_hits();
-  if (ns) flush_shadows();
-  return hits;
+void Accel::set_packet_width(int width) {
+  if (width != 8 && width != 16) throw std::invalid_argument("Accel: packet width must be 8 or 16");
+  m_impl->packet_width = width;
 }
 
 }  // namespace pt

@@ -43,11 +43,11 @@ class Accel {
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
   // True when anything blocks the ray within [ray.tmin, ray.tmax].
   bool occluded(const Ray& ray) const;
-  // The same queries for n rays at once, traced in Embree packets of packet_width() rays
-  // (bench_ceiling: 26-38% more rays/s than one at a time on the course scenes, packets of 16 on
-  // an AVX-512 host). found[i] / blocked[i] are 1 or 0; hits[i] is written where found[i]. Packet
-  // traversal may round a few hits differently from the single-ray kernel (5 in 100,000 random
-  // rays in the last bit of t, u, v or Ng; none of them turned a hit into a miss).
+  // The same queries for n rays at once, traced in Embree packets of packet_width() rays (faster
+  // than one at a time: docs/performance.md, "Ray packets"). found[i] / blocked[i] are 1 or 0;
+  // hits[i] is written where found[i]. Packet traversal may round a few hits differently from the
+  // single-ray kernel (5 in 100,000 random rays in the last bit of t, u, v or Ng; none of them
+  // turned a hit into a miss).
   void intersect_many(const Ray* rays, size_t n, SurfaceHit* hits, uint8_t* found) const {
     intersect_many(rays, sizeof(Ray), n, hits, found);
   }
@@ -56,7 +56,7 @@ class Accel {
   void intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const;
   void occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const;
   // Rays per Embree packet in intersect_many / occluded_many: Embree's native width, 16 on
-  // AVX-512 and 8 below it. set_packet_width (8 or 16) overrides it, for tests and benchmarks.
+  // AVX-512 and 8 below it. set_packet_width (8 or 16) overrides it, for tests.
   int packet_width() const;
   void set_packet_width(int width);
   // Bytes held for rendering: everything Embree allocated (BVH, vertex and index buffers, as its
@@ -66,63 +66,11 @@ class Accel {
   // the bounds are not finite (nothing may be assumed about misses then).
   bool hit_bounds(Vec3& lo, Vec3& hi) const;
 
-  // Benchmarks only (bench/ceiling.cpp; the renderer never calls it): casts rays[0, n) straight
-  // through Embree. single: rtcIntersect1 / rtcOccluded1 per ray; stream: rtcIntersect1M /
-  // rtcOccluded1M, `batch` rays a call; packet16: rtcIntersect16 / rtcOccluded16, 16 consecutive
-  // rays of a kind a call (what Mitsuba 3's LLVM variants call on AVX-512); packet8: the same with
-  // rtcIntersect8 / rtcOccluded8 (the native width on AVX2). Stream and packets
-  // gather intersect and shadow rays separately. shadow[i] != 0 makes ray i an occlusion query.
-  // Returns how many rays hit.
-  enum class RawMode { single, stream, packet16, packet8 };
-  size_t cast_raw(const Ray* rays, const uint8_t* shadow, size_t n, RawMode mode, size_t batch) const;
-
-  // Benchmarks only (bench/minimal_loop_lanes.h; the renderer never calls them): 16 rays kept in
-  // Embree's own packet layout (RTCRayHit16's fields in order), traced where they lie, with no
-  // packing and no hit refinement: what an integrator whose rays live in lanes would call. Lanes
-  // whose valid[k] (16 ints, -1 or 0, 64-byte aligned as Embree reads them) is 0 are left as they
-  // are. Before intersect16 the caller sets tnear, tfar and geom[k] = inst[k] = ~0u; it leaves t in
-  // tfar, geom[k] != ~0u where a lane hit and Embree's unnormalised geometric normal in ng*.
-  // occluded16 reads only the ray fields and sets tfar < 0 where a lane is blocked. Both are
-  // recorded and timed like every query.
-  struct RayPacket16 {
-    alignas(64) float ox[16], oy[16], oz[16], tnear[16], dx[16], dy[16], dz[16], time[16], tfar[16];
-    uint32_t mask[16], id[16], flags[16];
-    float ngx[16], ngy[16], ngz[16], u[16], v[16];
-    uint32_t prim[16], geom[16], inst[16];
-  };
-  void intersect16(const int* valid, RayPacket16& r) const;
-  void occluded16(const int* valid, RayPacket16& r) const;
-  // The light index of what intersect16 hit (geom[k], prim[k]): >= 0 on an emitter, else -1.
-  int light_at(uint32_t geom, uint32_t prim) const;
-
   struct Impl;
 
  private:
   std::unique_ptr<Impl> m_impl;
 };
-
-// Benchmarks only: every ray a thread passes to Accel::intersect / occluded, in order.
-struct RayRecorder {
-  std::vector<Ray> rays;
-  std::vector<uint8_t> shadow;  // 1: an occluded() query, 0: intersect()
-};
-// Starts (or with nullptr stops) recording the calling thread's rays into `r`. Unset (the
-// default) it costs one thread-local pointer test per query.
-void record_rays_on_this_thread(RayRecorder* r);
-
-// Benchmarks only: where a thread's time goes around Embree, in ticks of accel_ticks()'s clock.
-// `embree` sums the Embree calls themselves (every intersect and occluded query, raw replays
-// included); `refine` sums the refinement of their hits (the hit point, normals, material), which
-// the raw replays skip. bench_ceiling splits the path tracer's time with them.
-struct AccelTimer {
-  uint64_t embree = 0, refine = 0;
-};
-// Starts (or with nullptr stops) timing the calling thread's queries into `t`. Unset (the
-// default) it costs one thread-local pointer test per Embree call.
-void time_accel_on_this_thread(AccelTimer* t);
-// The clock AccelTimer counts in: the CPU's time-stamp counter on x86 (a few cycles a read),
-// steady_clock nanoseconds elsewhere. Only differences of it mean anything.
-uint64_t accel_ticks();
 
 // Offsets follow Waechter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
 // Ray Tracing Gems ch. 6 (2019), so they scale with the hit's coordinates: an integer ULP offset

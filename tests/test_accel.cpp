@@ -8,7 +8,6 @@
 #include <random>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "accel.h"
 #include "collada.h"
@@ -136,36 +135,6 @@ TEST(Accel, AgreesWithBruteForceAroundTheSceneBoundsFarFromTheOrigin) {
   check_against_reference(Vec3(3000, -2000, 1000));
 }
 
-// bench_ceiling's raw modes trace the same rays Accel does: one ray at a time, in streams and in
-// packets of 16 and 8 (a partial last packet included) they find the same hits as intersect / occluded.
-TEST(Accel, RawModesOfTheCeilingBenchmarkAgreeWithTheWrapper) {
-  SceneDesc d = two_shapes(Vec3(0, 0, 0));
-  Accel accel(d, {}, {});
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<float> u(-1.f, 1.f);
-  std::vector<Ray> rays;
-  std::vector<uint8_t> shadow;
-  size_t expected = 0;
-  for (int i = 0; i < 2003; ++i) {
-    Ray r;
-    r.o = Vec3(3 * u(rng), 3 * u(rng), 3 * u(rng));
-    r.d = Vec3(0.3f * u(rng), 0.3f * u(rng), 0.6f) - r.o * 0.3f;
-    r.tmin = 0;
-    r.tmax = i % 3 == 0 ? 3.0f : kInf;
-    rays.push_back(r);
-    shadow.push_back(uint8_t(i % 3 == 0));
-    SurfaceHit h;
-    expected += shadow.back() ? accel.occluded(r) : accel.intersect(r, h);
-  }
-  ASSERT_GT(expected, 300u);
-  ASSERT_LT(expected, rays.size() - 300);
-  using M = Accel::RawMode;
-  EXPECT_EQ(accel.cast_raw(rays.data(), shadow.data(), rays.size(), M::single, 1), expected);
-  EXPECT_EQ(accel.cast_raw(rays.data(), shadow.data(), rays.size(), M::stream, 256), expected);
-  EXPECT_EQ(accel.cast_raw(rays.data(), shadow.data(), rays.size(), M::packet16, 16), expected);
-  EXPECT_EQ(accel.cast_raw(rays.data(), shadow.data(), rays.size(), M::packet8, 8), expected);
-}
-
 // intersect_many / occluded_many in packets of either width answer as intersect / occluded do, ray
 // by ray: the same hits, the same surface, t within the packet kernels' rounding, and the same
 // again with the rays read at a stride. 2003 rays: a partial last packet at both widths; rays that
@@ -272,56 +241,6 @@ TEST(Accel, RaysOutsideEmbreesRangeAreRefusedTheRestTraced) {
       EXPECT_EQ(blocked[i], want ? 1 : 0) << "ray " << i << ", packets of " << width;
     }
   }
-}
-
-// AccelTimer (bench_ceiling's split of the path tracer's time): only the thread it is set on,
-// only while set; Embree time for every kind of query, refinement time for packet hits.
-TEST(Accel, TimerCountsTheCallingThreadsQueriesWhileSet) {
-  SceneDesc d = two_shapes(Vec3(0, 0, 0));
-  Accel accel(d, {}, {});
-  Ray aimed;
-  aimed.o = Vec3(0.1f, 0.1f, 3);
-  aimed.d = Vec3(0, 0, -1);
-  aimed.tmin = 0;
-  aimed.tmax = kInf;
-  std::vector<Ray> rays(64, aimed);
-  std::vector<SurfaceHit> hits(rays.size());
-  std::vector<uint8_t> found(rays.size()), blocked(rays.size());
-  AccelTimer timer;
-  accel.intersect_many(rays.data(), rays.size(), hits.data(), found.data());  // not set yet: not counted
-  EXPECT_EQ(timer.embree, 0u);
-  EXPECT_EQ(timer.refine, 0u);
-
-  time_accel_on_this_thread(&timer);
-  const uint64_t t0 = accel_ticks();
-  accel.intersect_many(rays.data(), rays.size(), hits.data(), found.data());
-  const uint64_t after_packets = timer.embree, refined = timer.refine;
-  EXPECT_GT(after_packets, 0u);
-  EXPECT_GT(refined, 0u);  // every ray hit the quad
-  accel.occluded_many(rays.data(), rays.size(), blocked.data());
-  EXPECT_GT(timer.embree, after_packets);
-  uint64_t before = timer.embree;
-  SurfaceHit h;
-  EXPECT_TRUE(accel.intersect(aimed, h));
-  EXPECT_TRUE(accel.occluded(aimed));
-  EXPECT_GT(timer.embree, before);
-  EXPECT_GT(timer.refine, refined);  // the single hit's refinement
-  before = timer.embree;
-  const uint64_t refined_all = timer.refine;
-  std::vector<uint8_t> shadow(rays.size(), 0);
-  EXPECT_EQ(accel.cast_raw(rays.data(), shadow.data(), rays.size(), Accel::RawMode::packet8, 8), rays.size());
-  EXPECT_GT(timer.embree, before);
-  EXPECT_EQ(timer.refine, refined_all);  // raw casts refine nothing
-  const uint64_t elapsed = accel_ticks() - t0;
-  EXPECT_LE(timer.embree + timer.refine, elapsed);  // parts of the time between the two reads
-
-  // Another thread's queries are its own; and once unset, nothing is added.
-  const AccelTimer seen = timer;
-  std::thread([&] { accel.intersect_many(rays.data(), rays.size(), hits.data(), found.data()); }).join();
-  time_accel_on_this_thread(nullptr);
-  accel.intersect_many(rays.data(), rays.size(), hits.data(), found.data());
-  EXPECT_EQ(timer.embree, seen.embree);
-  EXPECT_EQ(timer.refine, seen.refine);
 }
 
 namespace {
