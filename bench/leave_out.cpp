@@ -1,5 +1,6 @@
-// bench_leave_out: samples/s of the specialised vs the generic path loop, and memory per primitive
-// of the shared render-scene base against the file's description.
+// bench_leave_out: samples/s of the path loop's forms (specialised against generic, with and without
+// packets and SIMD lanes), and memory per primitive of the shared render-scene base against the
+// file's description.
 //   bench_leave_out [runs=3] [scene.dae ...]   (defaults: course scenes in ../shared and ours)
 #include <chrono>
 #include <cstdio>
@@ -19,10 +20,16 @@ using bench::median;  // the middle two averaged: for an even runs count it used
 
 namespace {
 
+// The path loop's forms compared here: specialised on the scene's features (the default), with
+// every feature, one path at a time instead of in Embree packets, without SIMD lanes.
+enum class Form { specialised, generic, one_path, no_lanes };
+
 // Each run renders a view of one shared base, as the server's jobs do.
-double samples_per_second(const SceneBase& base, RenderParams p, bool generic) {
+double samples_per_second(const SceneBase& base, RenderParams p, Form form) {
   auto scene = make_view(base, p);
-  if (generic) scene->features.bits = kFeatAll;  // the path loop with every feature
+  if (form == Form::generic) scene->features.bits = kFeatAll;
+  if (form == Form::one_path) scene->loop.packets = false;
+  if (form == Form::no_lanes) scene->loop.lanes = false;
   RenderSession s(*scene, p);
   s.render_all();
   return s.stats().samples / s.stats().seconds;
@@ -71,10 +78,11 @@ int main(int argc, char** argv) {
   // B/prim: bytes per triangle or sphere; shared: the SceneBase (Embree BVH and buffers, our
   // shading arrays, lights), file: the SceneDesc's arrays. Per-job set-up: a whole render scene
   // (make_render_scene, what a server job used to build) against a view of the shared base.
-  std::printf("%-34s %-30s %12s %12s %8s %13s %11s %12s %9s\n", "scene", "features", "generic", "specialised", "ratio",
-              "shared B/prim", "file B/prim", "full scene", "view");
+  // packets, lanes: samples/s with them over without (the same images).
+  std::printf("%-34s %-30s %12s %12s %8s %8s %8s %13s %11s %12s %9s\n", "scene", "features", "generic", "specialised",
+              "ratio", "packets", "lanes", "shared B/prim", "file B/prim", "full scene", "view");
   ProgressBar bar("bench_leave_out");
-  int done = 0, total = int(scenes.size()) * runs * 2;
+  int done = 0, total = int(scenes.size()) * runs * 4;
   for (const std::string& path : scenes) {
     SceneDesc desc;
     try {
@@ -93,11 +101,15 @@ int main(int argc, char** argv) {
     p.adaptive = false;
     p.threads = 2;
     SceneBase base = make_scene_base(desc);
-    std::vector<double> gen, spec, full_s, view_s;
-    for (int r = 0; r < runs; ++r) {  // interleaved, so drift hits both alike
-      gen.push_back(samples_per_second(base, p, true));
+    std::vector<double> gen, spec, one, nolanes, full_s, view_s;
+    for (int r = 0; r < runs; ++r) {  // interleaved, so drift hits all alike
+      gen.push_back(samples_per_second(base, p, Form::generic));
       bar.update(double(++done) / total);
-      spec.push_back(samples_per_second(base, p, false));
+      spec.push_back(samples_per_second(base, p, Form::specialised));
+      bar.update(double(++done) / total);
+      one.push_back(samples_per_second(base, p, Form::one_path));
+      bar.update(double(++done) / total);
+      nolanes.push_back(samples_per_second(base, p, Form::no_lanes));
       bar.update(double(++done) / total);
       auto t0 = std::chrono::steady_clock::now();
       make_render_scene(desc, p);
@@ -112,8 +124,9 @@ int main(int argc, char** argv) {
     double prims = double(std::max<size_t>(1, desc.triangle_count() + desc.spheres.size()));
     std::string name = path.substr(path.find_last_of('/') + 1);
     bar.finish();
-    std::printf("%-34s %-30s %10.3f M %10.3f M %8.3f %13.1f %11.1f %9.3f ms %6.1f us\n", name.c_str(), feats.c_str(),
-                median(gen) / 1e6, median(spec) / 1e6, median(spec) / median(gen), base.memory_bytes() / prims,
+    std::printf("%-34s %-30s %10.3f M %10.3f M %8.3f %8.3f %8.3f %13.1f %11.1f %9.3f ms %6.1f us\n", name.c_str(),
+                feats.c_str(), median(gen) / 1e6, median(spec) / 1e6, median(spec) / median(gen),
+                median(spec) / median(one), median(spec) / median(nolanes), base.memory_bytes() / prims,
                 desc_bytes(desc) / prims, median(full_s) * 1e3, median(view_s) * 1e6);
   }
   return 0;
