@@ -1,6 +1,7 @@
 // The pathtracer command: course flags parse unchanged, bad flags are named, and the real
 // binary writes its images (PNG + _rate.png, EXR with metadata) or fails with a located error.
 #include "cli.h"
+#include "options.h"
 
 #include <gtest/gtest.h>
 
@@ -142,12 +143,43 @@ TEST(Cli, RateImageName) {
   EXPECT_EQ(rate_image_path("x.exr"), "x_rate.png");
 }
 
+// --help against the option table (renderer/options.cpp): every option's flag is documented, with
+// the table's course default where it has one, and every documented flag parses.
 TEST(Cli, HelpDocumentsEveryFlag) {
   RunResult r = run("--help");
   EXPECT_EQ(r.status, 0);
+  const std::string& help = r.output;
+  auto entry = [&](const std::string& flag) {  // the flag's line and its continuation lines
+    size_t at = help.find("\n  " + flag + " ");
+    if (at == std::string::npos) at = help.find("\n  " + flag + ",");
+    if (at == std::string::npos) return std::string();
+    size_t end = help.find("\n  -", at + 1);
+    return help.substr(at, end == std::string::npos ? std::string::npos : end - at);
+  };
+  for (const RenderOption& o : render_options()) {
+    if (!*o.flag) continue;
+    SCOPED_TRACE(o.name);
+    const std::string text = entry(o.flag);
+    ASSERT_FALSE(text.empty()) << o.flag << " is not in --help:\n" << help;
+    if (o.type != OptionType::boolean && o.course != 0)
+      EXPECT_NE(text.find(option_text(o, o.course)), std::string::npos) << "the default " << option_text(o, o.course)
+                                                                          << " is not in: " << text;
+  }
   for (const char* f : {"-s ", "-l ", "-t ", "-m ", "-e ", "-b ", "-d ", "-f ", "-r ", "-c ", "-a ", "-p ", "-H ",
                         "-h", "--file-camera", "--seed", "--no-adaptive", "--no-caustic-tracing", "--sampler", "--describe"})
-    EXPECT_NE(r.output.find(f), std::string::npos) << f;
+    EXPECT_NE(help.find(f), std::string::npos) << f;
+  // Every flag --help lists is one the parser takes (as a usage error at worst, never "unknown").
+  std::smatch m;
+  std::string rest = help;
+  int flags = 0;
+  while (std::regex_search(rest, m, std::regex("\n  (--?[a-zA-Z][a-z-]*)"))) {
+    const std::string flag = m[1];
+    rest = m.suffix();
+    ++flags;
+    RunResult f = run(flag + " " + test::own_scene("cornell.dae") + " --describe");
+    EXPECT_EQ(f.output.find("unknown option"), std::string::npos) << flag << ": " << f.output;
+  }
+  EXPECT_GT(flags, 25);
 }
 
 TEST(Cli, RendersPngRateImageAndExrWithMetadata) {
