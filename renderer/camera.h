@@ -9,10 +9,14 @@
 
 namespace pt {
 
+// The course's focal distance (-d): every default of it (CameraParams, RenderParams, the option
+// table, Camera) is this one.
+constexpr double kCourseFocalDistance = 4.7;
+
 struct CameraParams {
   int width = 800, height = 600;   // full frame in pixels (-r)
   float lens_radius = 0;           // -b; 0 is a pinhole
-  float focal_distance = 4.7f;     // -d: plane of focus, world units along the view axis
+  float focal_distance = float(kCourseFocalDistance);  // -d: plane of focus, world units along the view axis
   bool file_camera = false;        // use the scene file's camera pose and FOV as authored
   bool keep_fov = false;           // -r scales the course's 800x600 view instead of cropping it
   std::string settings_file;       // -c: course camera settings file
@@ -23,7 +27,7 @@ struct Camera {
   Vec3 right, up, back;            // camera-to-world axes (the camera looks along -back)
   float tan_half_w = 0, tan_half_h = 0;
   int width = 800, height = 600;
-  float lens_radius = 0, focal_distance = 1;
+  float lens_radius = 0, focal_distance = float(kCourseFocalDistance);
   float tmin = 0, tmax = kInf;
   float screen_distance = 0;       // pixels, as in the course's settings file
   Vec3 target;                     // what the course camera orbits (for the settings file)

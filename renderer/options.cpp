@@ -21,7 +21,7 @@ const std::vector<RenderOption> kOptions = {
      "pathtracer:max_depth", PT_FIELD(p.max_depth)},
     {"aperture", "-b", OptionType::real, 0, 1e6, 0, 0, "thin-lens lens radius (the course's aperture; 0 = pinhole)",
      "pathtracer:lens_radius", PT_FIELD(p.lens_radius)},
-    {"focal_distance", "-d", OptionType::real, 0, 1e12, 4.7, 4.7,
+    {"focal_distance", "-d", OptionType::real, 0, 1e12, kCourseFocalDistance, kCourseFocalDistance,
      "distance of the plane in focus along the view axis", "pathtracer:focal_distance", PT_FIELD(p.focal_distance)},
     {"spp", "-s", OptionType::integer, 1, 1 << 24, 1, 64, "camera rays (samples) per pixel", "pathtracer:spp",
      PT_FIELD(p.spp)},

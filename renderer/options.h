@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "camera.h"
 #include "sampler.h"
 
 namespace pt {
@@ -19,7 +20,7 @@ struct RenderParams {
   int max_depth = 1;               // -m: maximum ray depth (bounces; each specular event uses one)
   int threads = 1;                 // -t
   float lens_radius = 0;           // -b (the course calls it aperture)
-  float focal_distance = 4.7f;     // -d
+  float focal_distance = float(kCourseFocalDistance);  // -d
   int width = 800, height = 600;   // -r
   bool adaptive = true;            // -a: on by default, as in the course
   int adaptive_batch = 32;
