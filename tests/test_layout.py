@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The code's layout rules, checked on the source tree (docs/architecture.md):
+"""The code's layout rules, checked on the source tree (README.md, "Layout"):
 
 - no source file over 600 lines;
 - no #include cycle among the project's own headers;
