@@ -9,7 +9,8 @@ import socket
 import pytest
 import requests
 
-from support import CORNELL, TINY, RawConnection, Server, decode_png
+from images import decode_png
+from support import CORNELL, TINY, RawConnection, Server
 
 TOKEN = "s3cret-t0ken_with.symbols~"
 

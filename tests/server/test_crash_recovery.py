@@ -9,7 +9,7 @@ import json
 import random
 import time
 
-from support import decode_png, read_exr
+from images import decode_png, read_exr
 
 KILLS = 20
 SIZES = [(48, 36), (96, 72), (128, 96)]

@@ -14,7 +14,8 @@ import time
 import pytest
 import requests
 
-from support import CORNELL, ENDLESS, RENDER_SERVER, TINY, RawConnection, decode_png, raw_request
+from images import decode_png
+from support import CORNELL, ENDLESS, RENDER_SERVER, TINY, RawConnection, raw_request
 
 IEND = b"\x00\x00\x00\x00IEND\xaeB`\x82"
 

@@ -6,7 +6,8 @@ import os
 import threading
 import time
 
-from support import Api, decode_png
+from images import decode_png
+from support import Api
 
 JOB = {"scene": "cornell", "width": 64, "height": 48, "spp": 16, "max_depth": 3, "adaptive": False, "tile_size": 16}
 JOBS, WATCHERS, POLLERS = 20, 50, 4

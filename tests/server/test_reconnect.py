@@ -4,7 +4,8 @@ stream from there ends at the final image. The job being still running when the 
 connects is checked from its status event, not assumed from a clock."""
 import base64
 
-from support import TINY, Canvas, decode_png
+from images import Canvas, decode_png
+from support import TINY
 
 # Long enough to connect in the middle, bounded by its time limit (it then finishes as done).
 LONG = {"scene": "cornell", "width": 96, "height": 72, "spp": 65536, "adaptive": False, "max_depth": 3,

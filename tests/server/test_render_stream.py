@@ -3,7 +3,8 @@ clipped at the edges) and ends with state done; the painted tiles are the final 
 EXR and PNG are bit-identical to the pathtracer command's render of the same spec and seed."""
 import pytest
 
-from support import CORNELL, ENDLESS, Canvas, decode_png, read_exr, render_cli, tonemap_course
+from images import Canvas, decode_png, read_exr, render_cli, tonemap_course
+from support import CORNELL, ENDLESS
 
 SPECS = {
     # non-adaptive, 16-pixel tiles, two light samples

@@ -7,7 +7,8 @@ import base64
 import json
 import signal
 
-from support import ENDLESS, TINY, decode_png
+from images import decode_png
+from support import ENDLESS, TINY
 
 # Mid-render when killed, finishes by its time limit once restarted.
 LONG = {"scene": "cornell", "width": 96, "height": 72, "spp": 65536, "adaptive": False, "max_depth": 3,

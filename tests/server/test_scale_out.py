@@ -15,7 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from support import SOURCE_DIR, read_exr
+from images import read_exr
+from support import SOURCE_DIR
 
 RENDER_WORKER = Path(os.environ.get("PT_RENDER_WORKER", SOURCE_DIR / "build/render-worker"))
 # cornell has mirror and glass spheres and an area light: passes carry light-traced caustics too.

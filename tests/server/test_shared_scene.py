@@ -4,7 +4,8 @@ the focus endpoint build nothing more; listing the scenes builds nothing; an edi
 again. The server logs each build once ("scene 'NAME' built in ..."), which is what is counted."""
 import re
 
-from support import CORNELL, decode_png
+from images import decode_png
+from support import CORNELL
 
 BUILT = re.compile(r"render-server: scene '([^']+)' built in [0-9.]+ s \((\d+) triangles, (\d+) spheres, ([0-9.]+) MiB\)")
 SPEC = {"scene": "cornell", "width": 48, "height": 36, "spp": 16, "max_depth": 3, "adaptive": False,

@@ -5,7 +5,8 @@ import socket
 import threading
 import time
 
-from support import ENDLESS, Canvas, decode_png
+from images import Canvas, decode_png
+from support import ENDLESS
 
 JOB = {"scene": "cornell", "width": 128, "height": 96, "spp": 128, "adaptive": False, "max_depth": 3,
        "tile_size": 16, "seed": 2}
