@@ -63,7 +63,7 @@ def find_libllvm():
 
 
 def rel_mse(np, img, ref):
-    """The renderer's relative_mse: luminance, eps 0.01 (renderer/image.cpp)."""
+    """The renderer's relative_mse: luminance, eps 0.01 (renderer/util/image.cpp)."""
     w = np.array([0.2126, 0.7152, 0.0722])
     a, b = img[..., :3] @ w, ref[..., :3] @ w
     return float(np.mean((a - b) ** 2 / (b * b + 0.01)))

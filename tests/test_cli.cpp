@@ -253,7 +253,7 @@ TEST(Cli, AnUnwritableOutputFailsBeforeTheRender) {
   EXPECT_FALSE(test::file_exists(dir + "/no_such_folder"));
 }
 
-// The image module (renderer/image_module.h) is looked for beside the executable first, then where
+// The image module (renderer/util/image_module.h) is looked for beside the executable first, then where
 // the build put it: a copied pair works, and a broken copy falls back to the built one.
 TEST(Cli, ImageModuleBesideTheBinaryFirstThenTheBuiltOne) {
   std::string build_dir = PT_PATHTRACER;

@@ -1,4 +1,4 @@
-// Image I/O through the OpenImageIO module (renderer/image_module.h): nothing of OpenImageIO is
+// Image I/O through the OpenImageIO module (renderer/util/image_module.h): nothing of OpenImageIO is
 // mapped until the first image is read or written, and every function the module carries writes
 // what reads back. The course tone mapping and the error measures against values worked by hand.
 #include <gtest/gtest.h>

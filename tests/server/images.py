@@ -114,7 +114,7 @@ def read_exr(data):
 
 
 def tonemap_course(v):
-    """The renderer's 8-bit tone mapping (renderer/image.cpp), for cross-checking decoders."""
+    """The renderer's 8-bit tone mapping (renderer/util/image.cpp), for cross-checking decoders."""
     if not v > 0:
         return 0
     t = (1.41421356 * v) ** (1 / 2.2)
