@@ -4,7 +4,7 @@
 on this machine, in one run.
 
     python3 bench/vs_mitsuba.py [--scenes CBspheres,CBbunny] [--spp 64] [--runs 3] [--ref-spp 1024]
-                                [--ours=--no-caustic-tracing] [--profile]
+                                [--ours=--no-caustic-tracing] [--baseline OTHER_BUILD] [--profile]
 
 Mitsuba comes from PyPI into build/mitsuba-venv (mitsuba 3.5.2: later Dr.Jit versions emit LLVM IR
 that needs LLVM 16 or newer, and Debian 12 ships 14 and 15; Dr.Jit finds Debian's libLLVM through
@@ -146,16 +146,16 @@ def host_description():
     return f"{model}, {len(os.sched_getaffinity(0))} CPUs, {isa}"
 
 
-def ours_command(args, scene_path, depth, spp, out, seed, extra=()):
-    cmd = [str(BUILD / "pathtracer"), "-t", "2", "-s", str(spp), "-l", "1", "-m", str(depth), "-r", "480", "360",
+def ours_command(args, scene_path, depth, spp, out, seed, extra=(), build=BUILD):
+    cmd = [str(build / "pathtracer"), "-t", "2", "-s", str(spp), "-l", "1", "-m", str(depth), "-r", "480", "360",
            "--keep-fov", "--no-adaptive", "--quiet", "--seed", str(seed), *extra, "-f", str(out), str(scene_path)]
     if args.sampler:
         cmd[1:1] = ["--sampler", args.sampler]
     return cmd
 
 
-def run_ours(args, scene_path, depth, spp, out, seed, extra=()):
-    cmd = ours_command(args, scene_path, depth, spp, out, seed, extra)
+def run_ours(args, scene_path, depth, spp, out, seed, extra=(), build=BUILD):
+    cmd = ours_command(args, scene_path, depth, spp, out, seed, extra, build)
     text = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
     m = re.search(r"([\d.]+) s, ([\d.e+]+) samples/s", text)
     return float(m.group(1)), float(m.group(2))
@@ -170,6 +170,8 @@ def main():
     ap.add_argument("--depth", type=int, default=0, help="our -m for every scene (default: 5)")
     ap.add_argument("--sampler", default="", help="our sampler (sobol, independent; default ours)")
     ap.add_argument("--ours", default="", help="extra pathtracer flags for our timed runs, e.g. --ours=--no-caustic-tracing")
+    ap.add_argument("--baseline", default="", help="another build folder whose pathtracer runs beside ours, "
+                    "interleaved, against our reference: a change's effect on efficiency in the same run")
     ap.add_argument("--profile", action="store_true",
                     help="also measure each renderer's share of time in ray queries with perf (query_share.py)")
     args = ap.parse_args()
@@ -230,7 +232,7 @@ def main():
             progress(f"{name}: our reference", 0, started)
             run_ours(args, SHARED / file, depth, args.ref_spp, oref_path, 7919)
         oref = np.array(mi.Bitmap(str(oref_path)))
-        ot, orate, oe = [], [], []
+        ot, orate, oe, bt, be = [], [], [], [], []
         out = cache / f"ours-{name}-run.exr"
         for k in range(args.runs):
             progress(f"{name}: ours", k / args.runs, started)
@@ -238,6 +240,11 @@ def main():
             ot.append(sec)
             orate.append(rate)
             oe.append(rel_mse(np, np.array(mi.Bitmap(str(out))), oref))
+            if args.baseline:
+                sec, _ = run_ours(args, SHARED / file, depth, args.spp, out, 100 + k, args.ours.split(),
+                                  Path(args.baseline).resolve())
+                bt.append(sec)
+                be.append(rel_mse(np, np.array(mi.Bitmap(str(out))), oref))
         shares = None
         if args.profile:
             # After the timed runs, so that perf's own cost never enters a timing. Ours renders 4x the
@@ -256,11 +263,12 @@ def main():
         cross = rel_mse(np, mref, oref)
         m_sec, o_sec = statistics.median(mt), statistics.median(ot)
         m_err, o_err = statistics.median(me), statistics.median(oe)
+        base = (statistics.median(bt), statistics.median(be)) if args.baseline else None
         rows.append((name, depth, m_sec, pixels * args.spp / m_sec, m_err, o_sec, statistics.median(orate), o_err,
-                     mean_m, mean_o, cross, shares))
+                     mean_m, mean_o, cross, shares, base))
     print(header)
     samples, efficiency = [], []  # ours over Mitsuba's, per scene
-    for name, depth, m_sec, m_rate, m_err, o_sec, o_rate, o_err, mean_m, mean_o, cross, shares in rows:
+    for name, depth, m_sec, m_rate, m_err, o_sec, o_rate, o_err, mean_m, mean_o, cross, shares, base in rows:
         samples.append((name, o_rate / m_rate))
         efficiency.append((name, (m_err * m_sec) / (o_err * o_sec)))
         print(f"{name:<10} {'mitsuba':<9} {m_sec:8.3f} {m_rate / 1e6:12.2f} {m_err:10.5f} {1 / (m_err * m_sec):11.1f}")
@@ -269,6 +277,10 @@ def main():
         print(f"{'':<10} ours/mitsuba: samples/s {samples[-1][1]:.2f}x, efficiency "
               f"{efficiency[-1][1]:.2f}x; references: mean luminance {mean_o:.4f} vs {mean_m:.4f} "
               f"({100 * (mean_o / mean_m - 1):+.1f}%), relMSE between them {cross:.5f}")
+        if base:
+            b_sec, b_err = base
+            print(f"{'':<10} {'baseline':<9} {b_sec:8.3f} {'':>12} {b_err:10.5f} {1 / (b_err * b_sec):11.1f}   "
+                  f"ours/baseline: efficiency {(b_err * b_sec) / (o_err * o_sec):.3f}x ({args.baseline})")
         if shares:
             (m_q, m_n), (o_q, o_n) = shares
             print(f"{'':<10} share of time in ray queries (perf): Mitsuba {100 * m_q:.1f}% of {m_n} samples, "
