@@ -2,6 +2,7 @@
 // (lane_physics.inc) compiled at each. A lane namespace has the same names at every width:
 //
 //   F, I, M, V2, V3   a float, an int32, a mask, 2- and 3-vectors of floats, kWidth of each
+//   U                 an uint32 (the sampler's hashes)
 //   select(m, a, b)   a where m, else b; and the operators, dot, sqrt, abs, min, max, ...
 //
 //   lane1  width 1: float, int32_t, bool, Vec2, Vec3 (the scalar code: pt::Frame is lane1::Frame)
@@ -73,6 +74,17 @@ PT_LANE float max(float a, float b) { return std::max(a, b); }
 PT_LANE Vec3 load3(const float* x, const float* y, const float* z, int i) { return {x[i], y[i], z[i]}; }
 PT_LANE void store3(float* x, float* y, float* z, int i, Vec3 a) { x[i] = a.x, y[i] = a.y, z[i] = a.z; }
 PT_LANE Vec2 load2(const Vec2* p) { return *p; }
+
+using U = uint32_t;  // unsigned lanes: the sampler's hashes (sobol.inc)
+PT_LANE uint32_t load(const uint32_t* p) { return *p; }
+PT_LANE uint32_t reverse_bits(uint32_t x) {
+  x = __builtin_bswap32(x);
+  x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+  x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+  x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+  return x;
+}
+PT_LANE float to_float(uint32_t x) { return float(x); }
 PT_LANE Vec3 extract(Vec3 a, int) { return a; }
 
 #include "lane_physics.inc"
