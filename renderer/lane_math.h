@@ -2,7 +2,7 @@
 // (lane_physics.inc) compiled at each. A lane namespace has the same names at every width:
 //
 //   F, I, M, V2, V3   a float, an int32, a mask, 2- and 3-vectors of floats, kWidth of each
-//   U                 an uint32 (the sampler's hashes)
+//   U                 a uint32 (the sampler's hashes: sobol.inc)
 //   select(m, a, b)   a where m, else b; and the operators, dot, sqrt, abs, min, max, ...
 //
 //   lane1  width 1: float, int32_t, bool, Vec2, Vec3 (the scalar code: pt::Frame is lane1::Frame)
