@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "lane_math.h"
 #include "math.h"
 #include "scene.h"
 
@@ -72,31 +73,16 @@ class Accel {
   std::unique_ptr<Impl> m_impl;
 };
 
-// Offsets follow Waechter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
-// Ray Tracing Gems ch. 6 (2019), so they scale with the hit's coordinates: an integer ULP offset
-// away from the surface, a float offset near the origin. Inline: every bounce and shadow ray
-// passes here.
-inline float offset_ray_coordinate(float p, float n) {
-  constexpr float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
-  int32_t of = int32_t(int_scale * n);
-  int32_t bits;
-  std::memcpy(&bits, &p, 4);
-  bits += p < 0 ? -of : of;
-  float moved;
-  std::memcpy(&moved, &bits, 4);
-  return std::fabs(p) < origin ? p + float_scale * n : moved;
-}
-inline Vec3 offset_ray_origin(Vec3 p, Vec3 n) {
-  return {offset_ray_coordinate(p.x, n.x), offset_ray_coordinate(p.y, n.y), offset_ray_coordinate(p.z, n.z)};
-}
+// Ray origins pushed off the surface so that the ray cannot hit it again, in a scale-aware way
+// (Waechter & Binder 2019): lane_physics.inc, which the lanes share.
+using lane1::offset_ray_origin;
 
 // A ray leaving the surface in direction d, origin pushed off to the side d points to.
 // Rays that go into arrays are written in place (the out-parameter forms): a returned Ray is
 // built with narrow stores and copied with wide loads, which cannot take their data from those
 // stores and wait until they retire (docs/performance.md, "store forwarding").
 inline void spawn_ray(const SurfaceHit& hit, Vec3 d, Ray& r) {
-  Vec3 n = dot(d, hit.ng) >= 0 ? hit.ng : -hit.ng;
-  r.o = offset_ray_origin(hit.p + n * hit.offset, n);
+  r.o = lane1::spawn_origin(hit.p, hit.ng, hit.offset, d);
   r.d = d;
   r.tmin = 0;
   r.tmax = kInf;
@@ -111,8 +97,7 @@ inline Ray spawn_ray(const SurfaceHit& hit, Vec3 d) {
 constexpr float kShadowRayEnd = 1 - 1e-4f;
 // A shadow ray from the surface to a point on another surface (target excluded).
 inline void spawn_ray_to(const SurfaceHit& hit, Vec3 target, Ray& r) {
-  Vec3 n = dot(target - hit.p, hit.ng) >= 0 ? hit.ng : -hit.ng;
-  r.o = offset_ray_origin(hit.p + n * hit.offset, n);
+  r.o = lane1::spawn_origin(hit.p, hit.ng, hit.offset, target - hit.p);
   r.d = target - r.o;
   r.tmin = 0;
   r.tmax = kShadowRayEnd;

@@ -5,20 +5,20 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lane_math.h"
 #include "sampling.h"
-#include "simd.h"
-#include "simd8.h"
 
-// Camera rays in lanes (camera_lanes_body.inc): four wide in SSE2, eight in AVX2.
-namespace pt::lanes_sse2 {
-using namespace pt::simd;
-#include "camera_lanes_body.inc"
-}  // namespace pt::lanes_sse2
+// Camera rays at every width (camera_rays.inc): one at a time, four in SSE2, eight in AVX2.
+namespace pt::lane1 {
+#include "camera_rays.inc"
+}  // namespace pt::lane1
+namespace pt::lane4 {
+#include "camera_rays.inc"
+}  // namespace pt::lane4
 PT_BEGIN_AVX2
-namespace pt::lanes_avx2 {
-using namespace pt::simd8;
-#include "camera_lanes_body.inc"
-}  // namespace pt::lanes_avx2
+namespace pt::lane8 {
+#include "camera_rays.inc"
+}  // namespace pt::lane8
 PT_END_AVX2
 
 namespace pt {
@@ -138,24 +138,30 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
 }
 
 void Camera::pinhole_ray(float sx, float sy, Ray& r) const {
-  Vec3 dc((2 * sx - 1) * tan_half_w, (2 * sy - 1) * tan_half_h, -1);
   r.o = position;
-  r.d = normalize(right * dc.x + up * dc.y + back * dc.z);
+  r.d = lane1::pinhole_direction(*this, sx, sy);
   r.tmin = tmin;
   r.tmax = tmax;
 }
 
+namespace {
+
+// Rays for sensor points i < n: eight at a time in AVX2 where simd::use_avx2(), then four in
+// SSE2, the tail one by one. A null lens_u makes pinhole rays.
+void camera_rays(const Camera& c, const float* sx, const float* sy, const Vec2* lens_u, size_t n, Ray* out) {
+  size_t i = simd::use_avx2() ? lane8::camera_rays(c, sx, sy, lens_u, n, out) : 0;
+  i += lane4::camera_rays(c, sx + i, sy + i, lens_u ? lens_u + i : nullptr, n - i, out + i);
+  lane1::camera_rays(c, sx + i, sy + i, lens_u ? lens_u + i : nullptr, n - i, out + i);
+}
+
+}  // namespace
+
 void Camera::pinhole_rays(const float* sx, const float* sy, size_t n, Ray* out) const {
-  size_t i = simd::use_avx2() ? lanes_avx2::pinhole_rays(*this, sx, sy, n, out) : 0;
-  i += lanes_sse2::pinhole_rays(*this, sx + i, sy + i, n - i, out + i);
-  for (; i < n; ++i) pinhole_ray(sx[i], sy[i], out[i]);
+  camera_rays(*this, sx, sy, nullptr, n, out);
 }
 
 void Camera::generate_rays(const float* sx, const float* sy, const Vec2* lens_u, size_t n, Ray* out) const {
-  if (lens_radius <= 0) return pinhole_rays(sx, sy, n, out);
-  size_t i = simd::use_avx2() ? lanes_avx2::thin_lens_rays(*this, sx, sy, lens_u, n, out) : 0;
-  i += lanes_sse2::thin_lens_rays(*this, sx + i, sy + i, lens_u + i, n - i, out + i);
-  for (; i < n; ++i) generate_ray(sx[i], sy[i], lens_u[i], out[i]);
+  camera_rays(*this, sx, sy, lens_u, n, out);
 }
 
 Ray Camera::pinhole_ray(float sx, float sy) const {
@@ -165,16 +171,7 @@ Ray Camera::pinhole_ray(float sx, float sy) const {
 }
 
 void Camera::generate_ray(float sx, float sy, Vec2 lens_u, Ray& r) const {
-  if (lens_radius <= 0) return pinhole_ray(sx, sy, r);
-  // Thin lens: lens disk at z = 0, plane of focus at z = -focal_distance (camera space).
-  Vec3 dc((2 * sx - 1) * tan_half_w, (2 * sy - 1) * tan_half_h, -1);
-  Vec3 focus = dc * focal_distance;
-  Vec2 d = sample_concentric_disk(lens_u);
-  Vec3 lens(lens_radius * d.x, lens_radius * d.y, 0);
-  Vec3 dir = focus - lens;
-  if (!(length_squared(dir) > 0)) dir = dc;  // focal distance 0 at the lens centre: no direction left
-  r.o = position + right * lens.x + up * lens.y;
-  r.d = normalize(right * dir.x + up * dir.y + back * dir.z);
+  lane1::camera_ray(*this, sx, sy, lens_u, r.o, r.d);
   r.tmin = tmin;
   r.tmax = tmax;
 }

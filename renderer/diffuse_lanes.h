@@ -1,9 +1,9 @@
 // The path loop's most common vertex, many paths at a time: a diffuse surface lit by area lights
-// (rectangles and emissive meshes), then a cosine-weighted bounce. The same arithmetic as the scalar
-// path_step (Frame, face_viewer, sample_light, diffuse_*, power_heuristic, spawn_ray*), operation
-// for operation, four at a time in SSE2 lanes or eight in AVX2 where the CPU has it: the images are
-// bit-identical. The pool gathers its diffuse vertices into these arrays, runs the lanes, and
-// scatters the results back (integrator.cpp).
+// (rectangles and emissive meshes), then a cosine-weighted bounce. The functions the scalar
+// path_step calls (lane_physics.inc: Frame, face_viewer, sample_area_light, diffuse_*,
+// power_heuristic, russian_roulette, spawn_origin), four at a time in SSE2 lanes or eight in AVX2
+// where the CPU has it: the images are bit-identical. The pool gathers its diffuse vertices into
+// these arrays, runs the lanes, and scatters the results back (integrator.cpp).
 #pragma once
 
 #include <cstdint>
@@ -28,7 +28,8 @@ struct DiffuseVertices {
   alignas(32) float qx[kMaxLanes], qy[kMaxLanes], qz[kMaxLanes];  // or the point it picked on a mesh light
   alignas(32) float lx[kMaxLanes], ly[kMaxLanes], lz[kMaxLanes];  // and the light's normal there
   alignas(32) float ubx[kMaxLanes], uby[kMaxLanes];               // BSDF sample
-  alignas(32) float urr[kMaxLanes];                                // roulette; 2 where it is not played
+  alignas(32) int roulette[kMaxLanes];                             // whether Russian roulette is played
+  alignas(32) float urr[kMaxLanes];                                // and its random number
   // Out of light_pass: whether a shadow ray is needed, the ray, and what it carries if unblocked.
   alignas(32) int shadow[kMaxLanes];
   alignas(32) float sox[kMaxLanes], soy[kMaxLanes], soz[kMaxLanes];

@@ -79,13 +79,13 @@ void direct_light_sampling(const RenderScene& scene, const RenderParams& params,
       LightSample ls;
       Vec2 u = rng.next_2d();
       if (!sample_light(light, v.hit.p, u, ls)) continue;
-      if (dot(ls.wi, v.ng) <= 0) continue;  // below the surface
+      if (!lane1::above_surface(ls.wi, v.ng)) continue;
       Vec3 wi = v.frame.to_local(ls.wi);
       Vec3 f = eval_f<F>(v.material, v.wo, wi);
       if (is_black(f) || is_black(ls.radiance)) continue;
       ++rays;
       float w = light.is_delta() ? 1.0f : power_heuristic(n * ls.pdf, pdf_f<F>(v.material, v.wo, wi));
-      shadow(v.hit, ls, f * ls.radiance * (std::fabs(wi.z) * w / (ls.pdf * n)));
+      shadow(v.hit, ls, lane1::light_sample_share(f, ls.radiance, wi.z, w, ls.pdf, float(n)));
     }
   }
 }
@@ -231,9 +231,9 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
   if (!sample_f<F>(material, v.wo, u_lobe, u, bs)) return false;
   Vec3 wi_world = v.frame.to_world(bs.wi);
   // Reflection must leave on the viewer's side of the true surface (no shading-normal leaks).
-  if (!transmissive && dot(wi_world, ng) <= 0) return false;
+  if (!transmissive && !lane1::above_surface(wi_world, ng)) return false;
   st.beta *= bs.weight;
-  if (is_black(st.beta) || !is_finite(st.beta)) return false;
+  if (!lane1::is_live(st.beta)) return false;
   st.specular = bs.delta;
   if (bounce == 0) st.caustic_phase = bs.delta ? 0 : 1;
   else if (st.caustic_phase == 1 && bs.delta) st.caustic_phase = 2;
@@ -243,11 +243,7 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
   --st.depth_left;
 
   // Russian roulette from kRouletteStart: unbiased, and it bounds the path length for any -m.
-  if (bounce >= kRouletteStart) {
-    float q = std::min(0.95f, max_component(st.beta));
-    if (rng.next_float() >= q) return false;
-    st.beta /= q;
-  }
+  if (bounce >= kRouletteStart && !lane1::russian_roulette(true, rng.next_float(), st.beta)) return false;
   spawn_ray(hit, wi_world, st.ray);
   return true;
 }
@@ -325,11 +321,12 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
     v.dx[j] = st.ray.d.x, v.dy[j] = st.ray.d.y, v.dz[j] = st.ray.d.z;
     v.bx[j] = st.beta.x, v.by[j] = st.beta.y, v.bz[j] = st.beta.z;
     if (j >= n) {
-      v.ubx[j] = v.ubx[0], v.uby[j] = v.uby[0], v.urr[j] = v.urr[0];
+      v.ubx[j] = v.ubx[0], v.uby[j] = v.uby[0], v.roulette[j] = v.roulette[0], v.urr[j] = v.urr[0];
       continue;
     }
     v.ubx[j] = u[size_t(j)].x, v.uby[j] = u[size_t(j)].y;
-    v.urr[j] = st.bounce >= kRouletteStart ? samplers[size_t(j)]->next_float() : 2.0f;  // 2: no roulette
+    v.roulette[j] = st.bounce >= kRouletteStart;
+    v.urr[j] = v.roulette[j] ? samplers[size_t(j)]->next_float() : 0.0f;
     st.has_direct = true;
     st.direct_beta = st.beta;
   }

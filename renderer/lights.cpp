@@ -109,7 +109,7 @@ float EnvironmentMap::pdf(Vec3 dir) const {
 
 void sample_area_light_point(const Light& light, Vec2 u, Vec3& point, Vec3& normal) {
   if (light.kind == LightKind::rect) {
-    point = light.position + light.dim_x * (u.x - 0.5f) + light.dim_y * (u.y - 0.5f);
+    point = lane1::rect_light_point(light.position, light.dim_x, light.dim_y, u);
     normal = light.direction;
     return;
   }
@@ -128,16 +128,9 @@ bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s) {
     case LightKind::mesh: {
       Vec3 q, n;
       sample_area_light_point(light, u, q, n);
-      Vec3 d = q - p;
-      float dist2 = length_squared(d);
-      if (!(dist2 > 0)) return false;
-      s.wi = d / std::sqrt(dist2);
-      float cos_l = -dot(s.wi, n);
-      if (cos_l <= 0) return false;  // one-sided emitter seen from behind
-      s.pdf = dist2 / (light.area * cos_l);
       s.radiance = light.color;
       s.point = q;
-      return std::isfinite(s.pdf) && s.pdf > 0;
+      return lane1::sample_area_light(p, q, n, light.area, s.wi, s.pdf);
     }
     case LightKind::point:
     case LightKind::spot: {
@@ -184,12 +177,7 @@ bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s) {
 }
 
 float area_light_pdf(const Light& light, Vec3 p, Vec3 light_point, Vec3 n_light) {
-  Vec3 d = light_point - p;
-  float dist2 = length_squared(d);
-  float cos_l = std::fabs(dot(d, n_light)) / std::sqrt(dist2);
-  if (!(cos_l > 0) || light.area <= 0) return 0;
-  float pdf = dist2 / (light.area * cos_l);
-  return std::isfinite(pdf) ? pdf : 0;
+  return lane1::area_light_pdf(p, light_point, n_light, light.area);
 }
 
 Vec3 infinite_light_radiance(const Light& light, Vec3 dir) {

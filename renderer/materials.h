@@ -5,6 +5,7 @@
 // For glass and refraction z > 0 is outside (the side the normal points to).
 #pragma once
 
+#include "lane_math.h"
 #include "math.h"
 #include "sampling.h"
 #include "scene.h"
@@ -18,33 +19,22 @@ struct BsdfSample {
   bool delta = false;
 };
 
-// The Lambertian lobe, inline so that integrators specialised for diffuse-only scenes call it
-// directly; the switches in materials.cpp use the same functions.
-inline Vec3 diffuse_eval(const Material& m, Vec3 wo, Vec3 wi) {
-  return (wo.z > 0 && wi.z > 0) ? m.albedo * kInvPi : Vec3(0.0f);
-}
-inline float diffuse_pdf(Vec3 wo, Vec3 wi) { return wo.z > 0 ? cosine_hemisphere_pdf(wi.z) : 0; }
+// The Lambertian lobe (lane_physics.inc, which the lanes share), inline so that integrators
+// specialised for diffuse-only scenes call it directly; the switches in materials.cpp use it too.
+inline Vec3 diffuse_eval(const Material& m, Vec3 wo, Vec3 wi) { return lane1::diffuse_eval(m.albedo, wo, wi); }
+inline float diffuse_pdf(Vec3 wo, Vec3 wi) { return lane1::diffuse_pdf(wo, wi); }
 inline bool diffuse_sample(const Material& m, Vec3 wo, Vec2 u, BsdfSample& s) {
   s.delta = false;
-  if (wo.z <= 0) return false;
-  s.wi = sample_cosine_hemisphere(u);
-  s.pdf = cosine_hemisphere_pdf(s.wi.z);
-  if (s.pdf <= 0) return false;
   s.weight = m.albedo;  // (albedo / pi) * cos / (cos / pi)
-  return true;
+  return lane1::diffuse_sample(wo, u, s.wi, s.pdf);
 }
 
 // The shading normals at a hit seen from wo (world space): opaque surfaces are two-sided, so their
-// normals turn to the viewer, and a shading normal facing away falls back to the geometric one.
-// Transmissive surfaces keep theirs (z > 0 is outside). Camera and light paths both use it, so
-// that they agree on every vertex they share.
+// normals turn to the viewer, and a shading normal facing away falls back to the geometric one
+// (lane1::face_viewer). Transmissive surfaces keep theirs (z > 0 is outside). Camera and light
+// paths both use it, so that they agree on every vertex they share.
 inline void face_viewer(Vec3 wo, bool transmissive, Vec3& ng, Vec3& ns) {
-  if (transmissive) return;
-  if (dot(wo, ng) < 0) {
-    ng = -ng;
-    ns = -ns;
-  }
-  if (dot(wo, ns) <= 0) ns = ng;
+  if (!transmissive) lane1::face_viewer(wo, ng, ns);
 }
 
 // True when the material has only delta lobes (no eval, no light sampling).

@@ -65,21 +65,7 @@ inline float safe_sqrt(float v) { return std::sqrt(std::max(0.0f, v)); }
 inline float sqr(float v) { return v * v; }
 inline Vec3 reflect(Vec3 wo, Vec3 n) { return -wo + 2 * dot(wo, n) * n; }
 
-// Orthonormal frame around a unit normal n = z axis.
-// Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017.
-struct Frame {
-  Vec3 s, t, n;
-  Frame() : s(1, 0, 0), t(0, 1, 0), n(0, 0, 1) {}
-  explicit Frame(Vec3 normal) : n(normal) {
-    float sign = std::copysign(1.0f, n.z);
-    float a = -1.0f / (sign + n.z);
-    float b = n.x * n.y * a;
-    s = Vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    t = Vec3(b, sign + n.y * n.y * a, -n.y);
-  }
-  Vec3 to_local(Vec3 v) const { return {dot(v, s), dot(v, t), dot(v, n)}; }
-  Vec3 to_world(Vec3 v) const { return s * v.x + t * v.y + n * v.z; }
-};
+// The orthonormal shading frame, Frame, is lane_math.h's (written once for every lane width).
 
 struct Ray {
   Vec3 o, d;

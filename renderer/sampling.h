@@ -3,38 +3,16 @@
 
 #include <vector>
 
+#include "lane_math.h"
 #include "math.h"
 
 namespace pt {
 
-// cos and sin of a in [-pi/4, pi/4] by Taylor polynomials (degree 8 and 7): errors below 3e-8 and
-// 3e-7, under a float's rounding of the results near 1; much cheaper than sincosf's range reduction.
-inline void sincos_quarter(float a, float& s, float& c) {
-  float a2 = a * a;
-  s = a * (1 + a2 * (-1.0f / 6 + a2 * (1.0f / 120 + a2 * (-1.0f / 5040))));
-  c = 1 + a2 * (-0.5f + a2 * (1.0f / 24 + a2 * (-1.0f / 720 + a2 * (1.0f / 40320))));
-}
-
-// Cosine-weighted hemisphere around +z via Shirley-Chiu concentric disk mapping ("A Low
-// Distortion Map Between Disk and Square", 1997). Its angle is pi/4 * ratio or pi/2 minus that,
-// so one quarter-range sin/cos pair serves both wedges.
-inline Vec2 sample_concentric_disk(Vec2 u) {
-  float ox = 2 * u.x - 1, oy = 2 * u.y - 1;
-  if (ox == 0 && oy == 0) return {0, 0};
-  float s, c;
-  if (std::fabs(ox) > std::fabs(oy)) {
-    sincos_quarter((kPi / 4) * (oy / ox), s, c);
-    return {ox * c, ox * s};  // theta = a
-  }
-  sincos_quarter((kPi / 4) * (ox / oy), s, c);
-  return {oy * s, oy * c};  // theta = pi/2 - a: cos(theta) = sin(a), sin(theta) = cos(a)
-}
-inline Vec3 sample_cosine_hemisphere(Vec2 u) {
-  Vec2 d = sample_concentric_disk(u);
-  float z = safe_sqrt(1 - d.x * d.x - d.y * d.y);
-  return {d.x, d.y, z};
-}
-inline float cosine_hemisphere_pdf(float cos_theta) { return cos_theta > 0 ? cos_theta * kInvPi : 0; }
+// The warps the lanes share (sampling.h's part of lane_physics.inc), at width 1.
+using lane1::cosine_hemisphere_pdf;
+using lane1::sample_concentric_disk;
+using lane1::sample_cosine_hemisphere;
+using lane1::sincos_quarter;
 
 inline Vec3 sample_uniform_hemisphere(Vec2 u) {
   float z = u.x;
@@ -65,15 +43,8 @@ inline Vec2 sample_uniform_triangle(Vec2 u) {
   return {b0, b1};
 }
 
-// Power heuristic with beta = 2 (Veach 1997, section 9.2), counts folded into the pdfs.
-// In ratio form, a^2 / (a^2 + b^2) = 1 / (1 + (b/a)^2): squaring large (grazing light) pdfs
-// would overflow to inf / inf = NaN, and squaring tiny ones would underflow to 0 / 0.
-inline float power_heuristic(float pdf_a, float pdf_b) {
-  if (pdf_a == kInf) return 1;
-  if (!(pdf_a > 0)) return 0;
-  float r = pdf_b / pdf_a;
-  return 1 / (1 + r * r);
-}
+// Power heuristic with beta = 2 (Veach 1997, section 9.2): lane_physics.inc.
+using lane1::power_heuristic;
 
 // Piecewise-constant 1D distribution over n bins of [0, 1).
 class Distribution1D {

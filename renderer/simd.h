@@ -1,19 +1,8 @@
-// Four floats at a time with GCC vector extensions on SSE2 (the portable build's vectors), for
-// the loops that repeat scalar code lane by lane (diffuse_lanes.cpp, camera.cpp). The helpers
-// are in simd_ops.inc, which simd8.h also instantiates eight wide for AVX2.
+// Which vector lanes this CPU runs: the dispatch between the lanes of lane_math.h (SSE2, the
+// portable build, and AVX2 where the CPU has it), and the pragmas that compile code for AVX2.
 #pragma once
 
-#include <immintrin.h>
-
-#include <cstdint>
-
-#include "math.h"
-
 namespace pt::simd {
-
-#define PT_SIMD_WIDTH 4
-#include "simd_ops.inc"
-#undef PT_SIMD_WIDTH
 
 // Whether this CPU runs AVX2 (the code paths that use it dispatch on this).
 inline bool avx2_available() {
@@ -30,7 +19,7 @@ inline bool use_avx2() { return g_allow_avx2 && avx2_available(); }
 }  // namespace pt::simd
 
 // Code between these is compiled for AVX2: a target pragma for GCC, an attribute pragma for clang
-// (which the sanitizer build uses). Keep such code in namespaces of its own (see simd8.h), so
+// (which the sanitizer build uses). Keep such code in namespaces of its own (see lane_math.h), so
 // that no inline function of a header gets an AVX2 copy that the linker could pick for the
 // portable code. AVX2 without FMA: the same roundings as SSE2.
 #if defined(__clang__)

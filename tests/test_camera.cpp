@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "collada.h"
+#include "lane_math.h"
 #include "rng.h"
 #include "simd.h"
 #include "test_util.h"

@@ -119,7 +119,7 @@ TEST(Pcg32, NeighbouringStreamsAreUncorrelated) {
 
 // ---- the per-sample sampler (renderer/sampler.h) ----
 
-TEST(Sampler, Dim1TablesMatchTheDirectionNumbers) {
+TEST(Sampler, Dim1MatchesTheDirectionNumbers) {
   for (uint32_t i : {0u, 1u, 2u, 3u, 255u, 256u, 12345u, 0xdeadbeefu, 0xffffffffu}) {
     uint32_t r = 0, x = i;
     for (uint32_t v = 1u << 31; x; x >>= 1, v ^= v >> 1)
