@@ -57,8 +57,8 @@ struct Vertex {
   Vec3 wo;  // local
 };
 
-int samples_for(const Light& light, const RenderParams& params) {
-  return light.is_delta() ? 1 : params.light_samples;
+int samples_for(const Light& light, const PathSettings& settings) {
+  return light.is_delta() ? 1 : settings.light_samples;
 }
 
 // The shadow ray of a light sample, written into r.
@@ -71,10 +71,10 @@ inline void shadow_ray(const SurfaceHit& hit, const LightSample& ls, Ray& r) {
 // sample that needs a shadow ray hands it to `shadow(hit, sample, contribution)`, which adds the
 // contribution to the vertex's sum unless its shadow_ray is blocked (at once, or after a batch).
 template <uint32_t F, class ShadowSink>
-void direct_light_sampling(const RenderScene& scene, const RenderParams& params, const Vertex& v, Sampler& rng,
+void direct_light_sampling(const RenderScene& scene, const PathSettings& settings, const Vertex& v, Sampler& rng,
                            uint64_t& rays, ShadowSink&& shadow) {
   for (const Light& light : scene.lights) {
-    int n = samples_for(light, params);
+    int n = samples_for(light, settings);
     for (int k = 0; k < n; ++k) {
       LightSample ls;
       Vec2 u = rng.next_2d();
@@ -93,9 +93,9 @@ void direct_light_sampling(const RenderScene& scene, const RenderParams& params,
 // The course's -H estimator: (lights x light_samples) uniform hemisphere rays that count what
 // emits where they land.
 template <uint32_t F>
-Vec3 direct_hemisphere(const RenderScene& scene, const RenderParams& params, const Vertex& v, Sampler& rng,
+Vec3 direct_hemisphere(const RenderScene& scene, const PathSettings& settings, const Vertex& v, Sampler& rng,
                        uint64_t& rays) {
-  int n = int(scene.lights.size()) * params.light_samples;
+  int n = int(scene.lights.size()) * settings.light_samples;
   if (n == 0) return Vec3(0.0f);
   Vec3 sum(0.0f);
   for (int k = 0; k < n; ++k) {
@@ -164,7 +164,7 @@ struct PathState {
 // st.ray is the next ray. The scalar loop and the batched one both run it, so they trace the same
 // paths from the same random numbers.
 template <uint32_t F, class ShadowSink>
-bool path_step(const RenderScene& scene, const RenderParams& params, PathState& st, bool found, const SurfaceHit& hit,
+bool path_step(const RenderScene& scene, const PathSettings& settings, PathState& st, bool found, const SurfaceHit& hit,
                Sampler& rng, uint64_t& rays, ShadowSink&& shadow) {
   const int bounce = st.bounce++;
   if (!found) {
@@ -176,8 +176,8 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
         if (is_black(le)) continue;
         float w = 1;
         if (!st.specular)
-          w = params.hemisphere ? 0.0f
-                                : power_heuristic(st.prev_pdf, samples_for(light, params) * infinite_light_pdf(light, st.ray.d));
+          w = settings.hemisphere ? 0.0f
+                                : power_heuristic(st.prev_pdf, samples_for(light, settings) * infinite_light_pdf(light, st.ray.d));
         st.radiance += st.beta * le * w;
       }
     }
@@ -190,14 +190,14 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
     Vec3 le = emitted_radiance(material, Vec3(0, 0, dot(wo_world, hit.ng)));
     bool light_traced = false;
     if constexpr ((F & kFeatDelta) != 0)
-      light_traced = params.caustics_light_traced && st.caustic_phase == 2 && hit.light >= 0;
+      light_traced = settings.caustics_light_traced && st.caustic_phase == 2 && hit.light >= 0;
     if (!is_black(le) && !light_traced) {
       float w = 1;
       if (!st.specular) {
-        if (params.hemisphere) w = 0;
+        if (settings.hemisphere) w = 0;
         else if (hit.light >= 0) {
           const Light& light = scene.lights[hit.light];
-          w = power_heuristic(st.prev_pdf, samples_for(light, params) * area_light_pdf(light, st.prev_p, hit.p, hit.ng));
+          w = power_heuristic(st.prev_pdf, samples_for(light, settings) * area_light_pdf(light, st.prev_p, hit.p, hit.ng));
         }
       }
       st.radiance += st.beta * le * w;
@@ -216,8 +216,8 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
   if (!has_delta<F>(material)) {
     st.has_direct = true;
     st.direct_beta = st.beta;
-    if (params.hemisphere) st.direct_sum = direct_hemisphere<F>(scene, params, v, rng, rays);
-    else direct_light_sampling<F>(scene, params, v, rng, rays, shadow);
+    if (settings.hemisphere) st.direct_sum = direct_hemisphere<F>(scene, settings, v, rng, rays);
+    else direct_light_sampling<F>(scene, settings, v, rng, rays, shadow);
   }
 
   BsdfSample bs;
@@ -250,8 +250,8 @@ bool path_step(const RenderScene& scene, const RenderParams& params, PathState& 
 
 // One path at a time: every ray query answered at once.
 template <uint32_t F>
-Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray, Sampler& rng, uint64_t& rays) {
-  PathState st(ray, params.max_depth);
+Vec3 trace_path_t(const RenderScene& scene, const PathSettings& settings, Ray ray, Sampler& rng, uint64_t& rays) {
+  PathState st(ray, settings.max_depth);
   auto shadow = [&](const SurfaceHit& hit, const LightSample& ls, Vec3 contribution) {
     Ray r;
     shadow_ray(hit, ls, r);
@@ -261,7 +261,7 @@ Vec3 trace_path_t(const RenderScene& scene, const RenderParams& params, Ray ray,
     SurfaceHit hit;
     ++rays;
     bool found = scene.accel->intersect(st.ray, hit);
-    bool more = path_step<F>(scene, params, st, found, hit, rng, rays, shadow);
+    bool more = path_step<F>(scene, settings, st, found, hit, rng, rays, shadow);
     st.resolve_direct();
     if (!more) return st.radiance;
   }
@@ -291,11 +291,11 @@ struct ShadowBatch {
 // path_step for the pool's slots which[0, n), all of them at a diffuse hit with depth left, in lanes
 // (diffuse_lanes.h): the draws in path_step's order (light samples, the unused lobe number, the bounce,
 // roulette), light passes light by light, the bounce. The same bits as path_step.
-void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lanes::DiffuseVertices& v, const uint32_t* which,
+void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, lanes::DiffuseVertices& v, const uint32_t* which,
                       int n, std::vector<PoolSlot>& slots, Sampler* rngs, const SurfaceHit* hits, uint8_t* alive,
                       uint64_t& rays, ShadowBatch& shadows) {
   const int padded = (n + 7) & ~7;  // whole vectors of either width
-  const size_t nl = scene.lights.size() * size_t(params.light_samples);  // draws, light by light
+  const size_t nl = scene.lights.size() * size_t(settings.light_samples);  // draws, light by light
   static thread_local std::vector<Vec2> u_light, u;
   static thread_local std::vector<Sampler*> samplers;
   u_light.resize(size_t(n) * nl);
@@ -331,7 +331,7 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
     st.direct_beta = st.beta;
   }
   for (size_t l = 0; l < nl; ++l) {
-    const Light& light = scene.lights[l / size_t(params.light_samples)];
+    const Light& light = scene.lights[l / size_t(settings.light_samples)];
     if (is_black(light.color)) continue;
     for (int j = 0; j < padded; ++j) {
       Vec2 u = u_light[l * size_t(n) + size_t(j < n ? j : 0)];
@@ -343,7 +343,7 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
         v.lx[j] = normal.x, v.ly[j] = normal.y, v.lz[j] = normal.z;
       }
     }
-    lanes::light_pass(v, padded, light, params.light_samples);
+    lanes::light_pass(v, padded, light, settings.light_samples);
     shadows.make_room(size_t(n));  // at most a shadow ray a vertex
     const size_t first = shadows.n;
     for (int j = 0; j < n; ++j) {
@@ -384,12 +384,12 @@ void diffuse_in_lanes(const RenderScene& scene, const RenderParams& params, lane
 // their rays traced together, then all their shadow rays; a finished path's slot takes the next
 // one. The same paths as the scalar loop, up to the packet kernel's rounding of a few hits.
 template <uint32_t F>
-void trace_paths_t(const RenderScene& scene, const RenderParams& params, const Ray* camera_rays, Sampler* rngs,
+void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const Ray* camera_rays, Sampler* rngs,
                    size_t n, Vec3* out, uint64_t& rays) {
   constexpr size_t kSlots = lanes::kMaxLanes;  // 64 to 4096 measured the same on CBdragon
   using Slot = PoolSlot;
   using Shadow = PendingShadow;
-  const bool use_lanes = diffuse_lanes_apply(scene, params);
+  const bool use_lanes = diffuse_lanes_apply(scene, settings);
   // The pool's arrays live on the thread between calls: a call per flush of a few thousand paths
   // would otherwise zero some 60 KB each time.
   struct Pool {
@@ -416,7 +416,7 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
   size_t next = 0;
   for (;;) {
     for (; live < kSlots && next < n; ++live, ++next) {
-      slots[live].st.start(camera_rays[next], params.max_depth);
+      slots[live].st.start(camera_rays[next], settings.max_depth);
       slots[live].job = uint32_t(next);
     }
     if (live == 0) return;
@@ -439,10 +439,10 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
         s.slot = uint32_t(i);
         s.contribution = contribution;
       };
-      alive[i] = path_step<F>(scene, params, slots[i].st, found[i] != 0, hits[i], rngs[slots[i].job], rays, shadow);
+      alive[i] = path_step<F>(scene, settings, slots[i].st, found[i] != 0, hits[i], rngs[slots[i].job], rays, shadow);
     }
     if (n_lanes)
-      diffuse_in_lanes(scene, params, *lane_data, in_lanes.data(), int(n_lanes), slots, rngs, hits.data(), alive.data(),
+      diffuse_in_lanes(scene, settings, *lane_data, in_lanes.data(), int(n_lanes), slots, rngs, hits.data(), alive.data(),
                        rays, shadows);
     if (blocked.size() < shadows.n) blocked.resize(shadows.n);
     scene.accel->occluded_many(shadows.rays.data(), shadows.n, blocked.data());
@@ -458,7 +458,7 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
       }
       out[slots[i].job] = slots[i].st.radiance;
       if (next < n) {
-        slots[i].st.start(camera_rays[next], params.max_depth);
+        slots[i].st.start(camera_rays[next], settings.max_depth);
         slots[i].job = uint32_t(next++);
         ++i;
         continue;
@@ -472,19 +472,19 @@ void trace_paths_t(const RenderScene& scene, const RenderParams& params, const R
 
 }  // namespace
 
-bool diffuse_lanes_apply(const RenderScene& scene, const RenderParams& params) {
-  if (!scene.loop.lanes || params.hemisphere || params.light_samples < 1) return false;
+bool diffuse_lanes_apply(const RenderScene& scene, const PathSettings& settings) {
+  if (!scene.loop.lanes || settings.hemisphere || settings.light_samples < 1) return false;
   for (const Light& light : scene.lights)  // the lanes know no other light
     if (light.kind != LightKind::rect && light.kind != LightKind::mesh) return false;
   return true;
 }
 
-Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, Sampler& rng, uint64_t& rays) {
-  return trace_path_t<kFeatAll>(scene, params, ray, rng, rays);
+Vec3 trace_path(const RenderScene& scene, const PathSettings& settings, Ray ray, Sampler& rng, uint64_t& rays) {
+  return trace_path_t<kFeatAll>(scene, settings, ray, rng, rays);
 }
 
-PathBatchTracer path_batch_tracer_for(uint32_t bits, const RenderParams& params) {
-  if (params.hemisphere) return nullptr;  // -H casts its direct-light rays one at a time
+PathBatchTracer path_batch_tracer_for(uint32_t bits, const PathSettings& settings) {
+  if (settings.hemisphere) return nullptr;  // -H casts its direct-light rays one at a time
   static const PathBatchTracer table[] = {
       trace_paths_t<0>, trace_paths_t<1>, trace_paths_t<2>, trace_paths_t<3>,
       trace_paths_t<4>, trace_paths_t<5>, trace_paths_t<6>, trace_paths_t<7>,

@@ -9,20 +9,35 @@
 
 namespace pt {
 
+// What the path loop reads of the render options, and the session's choice of who renders the
+// caustic paths: a small value the loop's every form takes instead of all of RenderParams.
+struct PathSettings {
+  int max_depth = 1;       // -m
+  int light_samples = 1;   // -l
+  bool hemisphere = false; // -H
+  // The session's light tracer renders the paths E D+ S+ L (caustics.h), so the loop leaves them out.
+  bool caustics_light_traced = false;
+
+  PathSettings() = default;
+  explicit PathSettings(const RenderParams& p, bool light_traced = false)
+      : max_depth(p.max_depth), light_samples(p.light_samples), hemisphere(p.hemisphere),
+        caustics_light_traced(light_traced) {}
+};
+
 // One camera path's radiance (integrator.cpp), by the generic loop. `rays` counts every ray cast.
-Vec3 trace_path(const RenderScene& scene, const RenderParams& params, Ray ray, class Sampler& rng, uint64_t& rays);
+Vec3 trace_path(const RenderScene& scene, const PathSettings& settings, Ray ray, class Sampler& rng, uint64_t& rays);
 // The path loop specialised for a set of feature bits (one instantiation per combination).
-using PathTracer = Vec3 (*)(const RenderScene&, const RenderParams&, Ray, class Sampler&, uint64_t&);
+using PathTracer = Vec3 (*)(const RenderScene&, const PathSettings&, Ray, class Sampler&, uint64_t&);
 PathTracer path_tracer_for(uint32_t feature_bits);
 // The same paths, many at once: traces camera_rays[0, n) with samplers rngs[0, n) (each already
 // past its pixel and lens draws) and writes each path's radiance to out[i]. Rays go to Embree in
 // packets (Accel::intersect_many). nullptr where the scalar loop must run (-H).
-using PathBatchTracer = void (*)(const RenderScene&, const RenderParams&, const Ray* camera_rays, class Sampler* rngs,
+using PathBatchTracer = void (*)(const RenderScene&, const PathSettings&, const Ray* camera_rays, class Sampler* rngs,
                                  size_t n, Vec3* out, uint64_t& rays);
-PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const RenderParams& params);
+PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const PathSettings& settings);
 // Whether the batched loop takes its diffuse vertices in SIMD lanes (diffuse_lanes.h): lanes on
 // (LoopForms), every light an area light (rectangle or mesh), light sampling (not -H).
-bool diffuse_lanes_apply(const RenderScene& scene, const RenderParams& params);
+bool diffuse_lanes_apply(const RenderScene& scene, const PathSettings& settings);
 // Whether packets take their Sobol draws eight at a time (Sampler::next_2d_many / sobol_draws):
 // the Sobol sampler, lanes on, and a CPU with AVX2.
 bool sobol_draws_in_lanes(const RenderScene& scene, const RenderParams& params);

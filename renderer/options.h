@@ -35,9 +35,6 @@ struct RenderParams {
   int tile_size = 32;
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
   bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
-  // Set by RenderSession, not by users: its light tracer renders the caustic paths (caustics.h),
-  // so the path loop leaves them out.
-  bool caustics_light_traced = false;
 
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;

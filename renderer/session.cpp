@@ -40,11 +40,10 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
       m_frame_x0(params.cell_w > 0 ? params.cell_x : 0),
       // the cell's bottom-left origin, as a top-left one
       m_frame_y0(params.cell_w > 0 ? params.height - (params.cell_y + params.cell_h) : 0),
-      m_caustics_light_traced(caustic_tracing_applies(scene, params)),
-      m_film(film_width(params), film_height(params), params.spp, adaptive_rule(params), m_caustics_light_traced) {
-  m_params.caustics_light_traced = m_caustics_light_traced;
+      m_path(params, caustic_tracing_applies(scene, params)),
+      m_film(film_width(params), film_height(params), params.spp, adaptive_rule(params), m_path.caustics_light_traced) {
   const int w = width(), h = height();
-  if (m_caustics_light_traced) m_caustic_film = {params.width, params.height, m_frame_x0, m_frame_y0, w, h};
+  if (m_path.caustics_light_traced) m_caustic_film = {params.width, params.height, m_frame_x0, m_frame_y0, w, h};
   int ts = params.tile_size;
   for (int y = 0; y < h; y += ts)
     for (int x = 0; x < w; x += ts) m_tiles.push_back({x, y, std::min(x + ts, w), std::min(y + ts, h)});
@@ -235,7 +234,7 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
   target_spp = std::min(target_spp, m_params.spp);
   auto start = std::chrono::steady_clock::now();
   m_film.invalidate_estimate();
-  if (m_caustics_light_traced) trace_caustics(target_spp, cancel);
+  if (m_path.caustics_light_traced) trace_caustics(target_spp, cancel);
   std::atomic<size_t> next{0};
   auto worker = [&]() {
     const uint64_t cpu_start = thread_cpu_ns();
@@ -295,7 +294,7 @@ double RenderSession::progress() const {
 
 void RenderSession::set_sample_range(uint32_t first, const std::vector<uint8_t>& skip) {
   m_first_sample = first;
-  if (m_caustics_light_traced) m_lt_issued = light_paths_for(first);
+  if (m_path.caustics_light_traced) m_lt_issued = light_paths_for(first);
   m_film.skip(skip);
 }
 

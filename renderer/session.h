@@ -106,9 +106,9 @@ class RenderSession : public PassSource {
   const RenderScene& m_scene;
   RenderParams m_params;
   int m_frame_x0, m_frame_y0;  // film origin inside the full frame, top-left
-  // Caustics by light tracing (caustics.h): its light tracer renders the caustic paths, so the path
-  // loop leaves them out.
-  bool m_caustics_light_traced;
+  // What the path loop reads of the options, and whether the session's light tracer renders the
+  // caustic paths (caustics.h), which the loop then leaves out.
+  PathSettings m_path;
   Film m_film;
   // Pixels whose every camera ray misses the scene (frame pixel coordinates, y up): outside this
   // rectangle a sample is black and costs no ray query. Off (empty) for a visible environment.

@@ -28,7 +28,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
   const RenderParams& p = m_params;
   const int w = width();
   if (packets_apply(m_scene, p)) {
-    if (PathBatchTracer many = path_batch_tracer_for(m_scene.features.bits, p)) {
+    if (PathBatchTracer many = path_batch_tracer_for(m_scene.features.bits, m_path)) {
       render_tile_batched(t, target, cancel, rays, samples, nonfinite, many);
       return;
     }
@@ -55,7 +55,7 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
           Sampler rng(p.sampler, p.seed, pixel_index, m_first_sample + s);
           Ray ray;
           camera_ray(fx, fy_up, rng, ray);
-          l = trace(m_scene, p, ray, rng, rays);
+          l = trace(m_scene, m_path, ray, rng, rays);
         }
         ++samples;
         if (m_film.add_sample(i, s, l, nonfinite)) {
@@ -137,7 +137,7 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
     if (camera_rays.size() < n) camera_rays.resize(n);  // kept between flushes: no zeroing
     m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
     out.resize(n);
-    if (n) trace(m_scene, p, camera_rays.data(), rngs.data(), n, out.data(), rays);
+    if (n) trace(m_scene, m_path, camera_rays.data(), rngs.data(), n, out.data(), rays);
     samples += n;
     for (size_t k = 0; k < n; ++k)  // job k traced camera ray k
       if (m_film.add_sample(jobs[k].pixel, jobs[k].sample, out[k], nonfinite)) {

@@ -73,7 +73,7 @@ TEST(Packets, BatchedPathsRenderWhatThePathByPathLoopRenders) {
     SceneDesc desc = load_collada(c.path);
     RenderParams p = c.params;
     auto scene = make_render_scene(desc, p);
-    ASSERT_NE(path_batch_tracer_for(scene->features.bits, p), nullptr);
+    ASSERT_NE(path_batch_tracer_for(scene->features.bits, PathSettings(p)), nullptr);
     RenderSession batched(*scene, p);
     batched.render_all();
     RenderScene one_by_one = *scene;
@@ -106,10 +106,10 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
     if (c.path.empty()) test::area_lights_as_meshes(desc);  // sampled by triangle before the lanes
     RenderParams p = c.params;
     auto scene = make_render_scene(desc, p);
-    laned += diffuse_lanes_apply(*scene, p);
+    laned += diffuse_lanes_apply(*scene, PathSettings(p));
     RenderScene scalar = *scene;
     scalar.loop.lanes = false;
-    EXPECT_FALSE(diffuse_lanes_apply(scalar, p));
+    EXPECT_FALSE(diffuse_lanes_apply(scalar, PathSettings(p)));
     RenderSession without(scalar, p);
     without.render_all();
     test::AllowAvx2Afterwards restore;
@@ -133,24 +133,24 @@ TEST(Packets, DiffuseLanesTakeOnlyAreaLights) {
   SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
   RenderParams p;
   auto scene = make_render_scene(desc, p);
-  EXPECT_TRUE(diffuse_lanes_apply(*scene, p));
+  EXPECT_TRUE(diffuse_lanes_apply(*scene, PathSettings(p)));
   p.light_samples = 4;
-  EXPECT_TRUE(diffuse_lanes_apply(*scene, p));
+  EXPECT_TRUE(diffuse_lanes_apply(*scene, PathSettings(p)));
   p.hemisphere = true;
-  EXPECT_FALSE(diffuse_lanes_apply(*scene, p));
+  EXPECT_FALSE(diffuse_lanes_apply(*scene, PathSettings(p)));
   p.hemisphere = false;
   SceneDesc meshed = desc;
   test::area_lights_as_meshes(meshed);
   auto mesh_lit = make_render_scene(meshed, p);
   ASSERT_EQ(mesh_lit->lights.size(), 1u);
   EXPECT_EQ(mesh_lit->lights[0].kind, LightKind::mesh);
-  EXPECT_TRUE(diffuse_lanes_apply(*mesh_lit, p));
+  EXPECT_TRUE(diffuse_lanes_apply(*mesh_lit, PathSettings(p)));
   RenderScene other = *scene;
   Light point;
   point.kind = LightKind::point;
   point.color = Vec3(1.0f);
   other.lights.push_back(point);
-  EXPECT_FALSE(diffuse_lanes_apply(other, p));
+  EXPECT_FALSE(diffuse_lanes_apply(other, PathSettings(p)));
 }
 
 TEST(Packets, HemisphereSamplingTracesPathByPath) {
@@ -158,7 +158,7 @@ TEST(Packets, HemisphereSamplingTracesPathByPath) {
   RenderParams p;
   p.hemisphere = true;  // its direct-light rays look emitters up one at a time
   auto scene = make_render_scene(desc, p);
-  EXPECT_EQ(path_batch_tracer_for(scene->features.bits, p), nullptr);
+  EXPECT_EQ(path_batch_tracer_for(scene->features.bits, PathSettings(p)), nullptr);
   p.hemisphere = false;
-  EXPECT_NE(path_batch_tracer_for(scene->features.bits, p), nullptr);
+  EXPECT_NE(path_batch_tracer_for(scene->features.bits, PathSettings(p)), nullptr);
 }

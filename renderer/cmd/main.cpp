@@ -54,7 +54,7 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
   const bool packets = packets_apply(scene, o.params);
   if (packets) std::printf("ray queries:      paths in Embree packets of %d\n", scene.accel->packet_width());
   else std::printf("ray queries:      one path at a time\n");
-  const char* diffuse = !(packets && diffuse_lanes_apply(scene, o.params)) ? "one at a time"
+  const char* diffuse = !(packets && diffuse_lanes_apply(scene, PathSettings(o.params))) ? "one at a time"
                         : lanes::lane_width() == 8                        ? "eight at a time (AVX2 lanes)"
                                                                           : "four at a time (SSE2 lanes)";
   std::printf("diffuse vertices: %s\n", diffuse);
