@@ -5,7 +5,8 @@
 - no #include cycle among the project's own headers;
 - Embree is included by renderer/accel.cpp alone; the server never includes it, and the renderer
   never includes HTTP;
-- the renderer's library does not include its front ends (renderer/cmd/).
+- the renderer's library does not include its front ends (renderer/cmd/), and its helpers
+  (renderer/util/) include nothing of the library.
 """
 import re
 import sys
@@ -70,6 +71,14 @@ class Layout(unittest.TestCase):
         self.assertTrue(cmd, "renderer/cmd holds the front ends")
         library = [p for p in sources(["renderer"], {".h", ".cpp", ".inc"}) if "cmd" not in p.relative_to(ROOT).parts]
         users = [f"{p.relative_to(ROOT)}: {i}" for p in library for i in includes(p) if i.split("/")[-1] in cmd]
+        self.assertEqual(users, [])
+
+    def test_helpers_include_only_helpers(self):
+        util = ROOT / "renderer" / "util"
+        own = {p.name for p in util.iterdir()}
+        library = {p.name for p in sources(["renderer"], {".h", ".inc"})} - own
+        users = [f"{p.relative_to(ROOT)}: {i}" for p in util.iterdir() if p.suffix in {".h", ".cpp", ".inc"}
+                 for i in includes(p) if i.split("/")[-1] in library]
         self.assertEqual(users, [])
 
 
