@@ -21,7 +21,7 @@ namespace {
 // (bench/vs_mitsuba.py, docs/performance.md).
 constexpr int kRouletteStart = 5;
 
-// BSDF dispatch reduced to the material kinds the scene has (feature bits, render.h): a scene
+// BSDF dispatch reduced to the material kinds the scene has (feature bits, render_scene.h): a scene
 // without microfacet or delta materials calls the inline Lambertian lobe directly.
 template <uint32_t F>
 inline bool has_delta(const Material& m) {
