@@ -64,6 +64,21 @@ PassReport ProgressiveDriver::step(const std::atomic<bool>* cancel, const TileCa
   return report;
 }
 
+void ProgressiveDriver::save(BinaryWriter& out) const {
+  out.pod(int32_t(m_target)), out.pod(uint8_t(m_done)), out.pod(uint8_t(m_reason));
+}
+
+void ProgressiveDriver::restore(BinaryReader& in) {
+  const int32_t target = in.pod<int32_t>();
+  const uint8_t done = in.pod<uint8_t>(), reason = in.pod<uint8_t>();
+  if (target < 1 || target > m_source.film().spp() || done > 1 || reason > uint8_t(StopReason::cancelled))
+    in.fail("an impossible pass target or stop");
+  // A render that spent its budget stays done; one that stopped at a limit runs its last pass
+  // again (a pass with nothing to add) and lets the limits it runs under now decide.
+  m_target = target, m_reason = StopReason(reason);
+  m_done = done != 0 && m_reason == StopReason::finished;
+}
+
 StopReason run_progressive(PassSource& source, const RunLimits& limits, const std::atomic<bool>* cancel,
                            const TileCallback& on_tile, const std::function<void(const PassReport&)>& on_pass) {
   ProgressiveDriver driver(source, limits);

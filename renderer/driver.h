@@ -66,6 +66,9 @@ class ProgressiveDriver {
   bool done() const { return m_done; }
   StopReason reason() const { return m_reason; }
   int target() const { return m_target; }
+  // Checkpoints (checkpoint.h): the next pass's target and whether the render has ended.
+  void save(BinaryWriter& out) const;
+  void restore(BinaryReader& in);
 
  private:
   PassSource& m_source;

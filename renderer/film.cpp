@@ -171,6 +171,35 @@ FilmPass Film::to_pass(uint32_t first, uint32_t count) const {
   return out;
 }
 
+void Film::save(BinaryWriter& out) const {
+  out.pod(int32_t(m_w)), out.pod(int32_t(m_h)), out.pod(int32_t(m_spp)), out.pod(uint8_t(has_caustics()));
+  out.array(m_sum), out.array(m_s1), out.array(m_s2), out.array(m_half_s1), out.array(m_half_n);
+  out.array(m_count), out.array(m_done);
+  out.pod(m_half_samples), out.pod(m_other_samples);
+  out.array(m_lt_sum), out.array(m_lt_s1), out.array(m_lt_half_s1);
+  out.pod(m_lt_paths), out.pod(m_lt_half_paths);
+}
+
+void Film::restore(BinaryReader& in) {
+  const int32_t w = in.pod<int32_t>(), h = in.pod<int32_t>(), spp = in.pod<int32_t>();
+  const bool caustics = in.pod<uint8_t>() != 0;
+  if (w != m_w || h != m_h || spp != m_spp || caustics != has_caustics())
+    in.fail("a " + std::to_string(w) + "x" + std::to_string(h) + " film of " + std::to_string(spp) + " spp");
+  const size_t n = pixels(), lt = caustics ? n : 0;
+  in.array(m_sum, n), in.array(m_s1, n), in.array(m_s2, n), in.array(m_half_s1, n), in.array(m_half_n, n);
+  in.array(m_count, n), in.array(m_done, n);
+  m_half_samples = in.pod<uint64_t>(), m_other_samples = in.pod<uint64_t>();
+  in.array(m_lt_sum, lt), in.array(m_lt_s1, lt), in.array(m_lt_half_s1, lt);
+  m_lt_paths = in.pod<uint64_t>(), m_lt_half_paths = in.pod<uint64_t>();
+  for (size_t i = 0; i < n; ++i)
+    if (m_count[i] > uint32_t(m_spp) || m_half_n[i] > m_count[i] || m_done[i] > 1 || !is_finite(m_sum[i]) ||
+        !std::isfinite(m_s1[i]) || !std::isfinite(m_s2[i]) || !std::isfinite(m_half_s1[i]) ||
+        (caustics && (!is_finite(m_lt_sum[i]) || !std::isfinite(m_lt_s1[i]) || !std::isfinite(m_lt_half_s1[i]))))
+      in.fail("pixel " + std::to_string(i) + " holds impossible values");
+  if (m_lt_half_paths > m_lt_paths) in.fail("more light paths in a part than in all");
+  m_estimate.invalidate();
+}
+
 ImageRGB Film::image() const {
   return make_image(m_w, m_h, [this](size_t i) { return pixel_mean(i); });
 }

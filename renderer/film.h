@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "binary_io.h"
 #include "image.h"
 #include "math.h"
 
@@ -159,6 +160,13 @@ class Film {
   void merge(const FilmPass& pass);
   // The film's sums for sample range [first, first + count), as a worker sends them.
   FilmPass to_pass(uint32_t first, uint32_t count) const;
+
+  // ---- checkpoints ----
+  // Every statistic, so that a restored film continues exactly where this one stands.
+  void save(BinaryWriter& out) const;
+  // Reads what save() wrote for a film of this size, budget and kind; throws std::runtime_error
+  // (BinaryReader's) on anything that does not fit: another size, impossible counts, non-finite sums.
+  void restore(BinaryReader& in);
 
   // ---- reading ----
   // A pixel's radiance: the mean of its camera samples plus its splat sum over every light path.

@@ -298,6 +298,27 @@ void RenderSession::set_sample_range(uint32_t first, const std::vector<uint8_t>&
   m_film.skip(skip);
 }
 
+void RenderSession::save(BinaryWriter& out) const {
+  out.pod(m_first_sample), out.pod(m_lt_issued);
+  out.pod(m_samples.load()), out.pod(m_rays.load()), out.pod(m_nonfinite.load()), out.pod(m_cpu_ns.load());
+  out.pod(m_seconds), out.pod(int32_t(m_passes));
+  m_film.save(out);
+}
+
+void RenderSession::restore(BinaryReader& in) {
+  if (in.pod<uint32_t>() != m_first_sample) in.fail("another share of the samples");
+  m_lt_issued = in.pod<uint64_t>();
+  m_samples = in.pod<uint64_t>(), m_rays = in.pod<uint64_t>(), m_nonfinite = in.pod<uint64_t>();
+  m_cpu_ns = in.pod<uint64_t>();
+  m_seconds = in.pod<double>();
+  m_passes = in.pod<int32_t>();
+  if (!(m_seconds >= 0 && m_seconds < 1e12) || m_passes < 0) in.fail("impossible render time or pass count");
+  m_film.restore(in);
+  uint64_t credit = 0;  // as the tiles count progress: a done pixel's whole budget, else its samples
+  for (size_t i = 0; i < m_film.pixels(); ++i) credit += m_film.done(i) ? uint64_t(m_params.spp) : m_film.count(i);
+  m_budget_done = credit;
+}
+
 SessionStats RenderSession::stats() const {
   SessionStats s;
   s.samples = m_samples.load();

@@ -64,6 +64,11 @@ class RenderSession : public PassSource {
   SessionStats stats() const;
   const std::vector<Tile>& tiles() const { return m_tiles; }
 
+  // Checkpoints (checkpoint.h): what the session has rendered, its film included. save() between
+  // passes; restore() before the first pass, into a session of the same scene and options.
+  void save(BinaryWriter& out) const;
+  void restore(BinaryReader& in);
+
   // For one share of a distributed render: sample indices start at `first` (so disjoint ranges
   // merge into the single-machine image; the caustic light paths follow the same share) and pixels
   // whose `skip` byte is set are left out. Call before the first pass.

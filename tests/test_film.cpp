@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "collada.h"
 #include "session.h"
@@ -184,6 +185,44 @@ TEST(Film, SessionPixelsStopOnlyAtTestCounts) {
     EXPECT_TRUE(film.rule().test_due(film.count(i))) << i << ": " << film.count(i);
   }
   EXPECT_GT(stopped, film.pixels() / 4) << "the walls converge early";
+}
+
+}  // namespace
+}  // namespace pt
+
+namespace pt {
+namespace {
+
+// A film saved and restored (checkpoints) holds the same statistics: the same image, mask and
+// error estimate; a film of another size or a cut record is refused.
+TEST(Film, SaveAndRestoreKeepEveryStatistic) {
+  Fixture f(64, true);
+  RenderSession session(*f.scene, f.params);
+  ASSERT_TRUE(session.render_all());
+  const Film& film = session.film();
+  ASSERT_TRUE(film.has_caustics());
+  BinaryWriter out;
+  film.save(out);
+  Film back(48, 36, 64, adaptive_rule(f.params), true);
+  BinaryReader in(out.bytes(), "film.bin");
+  back.restore(in);
+  EXPECT_TRUE(in.at_end());
+  const ImageRGB a = film.image(), b = back.image();
+  EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec3)), 0);
+  EXPECT_EQ(back.done_mask(), film.done_mask());
+  EXPECT_EQ(back.light_paths(), film.light_paths());
+  EXPECT_EQ(back.error_estimate(), film.error_estimate());
+  Film other(48, 36, 128, adaptive_rule(f.params), true);
+  BinaryReader again(out.bytes(), "film.bin");
+  EXPECT_THROW(other.restore(again), std::runtime_error);
+  const std::string cut = out.bytes().substr(0, out.bytes().size() - 9);
+  BinaryReader short_in(cut, "film.bin");
+  try {
+    back.restore(short_in);
+    ADD_FAILURE() << "a cut record was restored";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("film.bin: damaged (cut short"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -102,6 +102,11 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--seed") { need(a, 1); p.seed = uint64_t(parse_option(a, "seed", args[++i])); }
     else if (a == "--tile") { need(a, 1); p.tile_size = int(parse_option(a, "tile_size", args[++i])); }
     else if (a == "--quiet") { o.quiet = true; }
+    else if (a == "--checkpoint") {
+      need(a, 1);
+      o.checkpoint = args[++i];
+      if (o.checkpoint.empty()) throw UsageError("--checkpoint: empty file name");
+    } else if (a == "--checkpoint-interval") { need(a, 1); o.checkpoint_interval = parse_float(a, args[++i], 0, 1e9); }
     else if (a == "--script") { need(a, 1); o.script = args[++i]; }
     else if (a.size() > 1 && a[0] == '-') { throw UsageError("unknown option '" + a + "'"); }
     else {
@@ -111,6 +116,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
   }
   if (o.help) return o;
   if (o.scene_path.empty()) throw UsageError("no scene file given");
+  if (!o.checkpoint.empty() && o.output.empty()) throw UsageError("--checkpoint needs -f (the window keeps no checkpoint)");
   try {
     p.validate();
   } catch (const std::invalid_argument& e) {
@@ -160,6 +166,9 @@ std::string usage_text(const std::string& program) {
 "  --target-error <X>     stop once the estimated relative MSE is <= X\n"
 "  --time-limit <SEC>     stop after SEC seconds of rendering\n"
 "  --reference <FILE>     a converged image of the same size: log its true RMSE and relative MSE\n"
+"  --checkpoint <FILE>    save the render to FILE between passes; the same command run again\n"
+"                         continues it from there (the finished image is the same, bit for bit)\n"
+"  --checkpoint-interval <SEC>  seconds between checkpoints (default 30; 0 = after every pass)\n"
 "  --script <FILE> window only: replay input from FILE, one command a line (for tests):\n"
 "                  wait_spp N | wait_ms N | key K | click X Y | resize W H | sync |\n"
 "                  title | screenshot FILE.png | close | quit\n"

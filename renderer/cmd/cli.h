@@ -20,6 +20,8 @@ struct CliOptions {
   std::string error_log;   // --error-log: CSV of the error per pass
   std::string reference;   // --reference: true error against this image
   RunLimits limits;        // --target-error, --time-limit
+  std::string checkpoint;  // --checkpoint: resume from and save to this file
+  double checkpoint_interval = 30;  // --checkpoint-interval: seconds between saves (0: every pass)
 };
 
 class UsageError : public std::runtime_error {

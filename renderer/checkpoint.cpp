@@ -1,0 +1,106 @@
+// Checkpoint files (checkpoint.h).
+#include "checkpoint.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "options.h"
+
+namespace pt {
+
+namespace {
+
+constexpr char kMagic[8] = {'P', 'T', 'C', 'H', 'E', 'C', 'K', '1'};
+constexpr size_t kMaxFingerprint = 1 << 16;
+
+// FNV-1a, 64 bits: a scene's identity, not a defence against forgery (a checkpoint is our own file).
+uint64_t fnv1a(const std::string& bytes) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+[[noreturn]] void fail_io(const std::string& path, const char* doing) {
+  throw std::runtime_error(path + ": cannot " + doing + " the checkpoint (" + std::strerror(errno) + ")");
+}
+
+}  // namespace
+
+std::string render_fingerprint(const std::string& scene_bytes, const RenderParams& p) {
+  std::ostringstream f;
+  char hash[20];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(scene_bytes)));
+  f << "scene " << hash << " (" << scene_bytes.size() << " bytes)";
+  const RunLimits none;
+  for (const RenderOption& o : render_options()) {
+    const std::string name = o.name;
+    if (name == "time_limit" || name == "target_error" || name == "tile_size") continue;
+    f << ", " << name << " " << option_text(o, o.get(p, none));
+  }
+  f << ", sampler " << int(p.sampler) << ", environment '" << p.env_map << "', camera file '" << p.camera_file
+    << "', cell " << p.cell_x << " " << p.cell_y << " " << p.cell_w << " " << p.cell_h;
+  return f.str();
+}
+
+void save_checkpoint(const std::string& path, const std::string& fingerprint, const RenderSession& session,
+                     const ProgressiveDriver& driver) {
+  BinaryWriter out;
+  for (char c : kMagic) out.pod(c);
+  out.text(fingerprint);
+  driver.save(out);
+  session.save(out);
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail_io(tmp, "create");
+  const std::string& bytes = out.bytes();
+  for (size_t at = 0; at < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + at, bytes.size() - at);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      fail_io(tmp, "write");
+    }
+    at += size_t(n);
+  }
+  // On disk before the rename: a crash leaves the old checkpoint or the new one, never a torn file.
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    ::unlink(tmp.c_str());
+    fail_io(tmp, "flush");
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    ::unlink(tmp.c_str());
+    fail_io(path, "replace");
+  }
+}
+
+bool restore_checkpoint(const std::string& path, const std::string& fingerprint, RenderSession& session,
+                        ProgressiveDriver& driver) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    if (errno == ENOENT) return false;
+    fail_io(path, "read");
+  }
+  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    throw std::runtime_error(path + ": not a pathtracer checkpoint");
+  BinaryReader in(bytes, path);
+  for (size_t k = 0; k < sizeof kMagic; ++k) in.pod<char>();
+  const std::string theirs = in.text(kMaxFingerprint);
+  if (theirs != fingerprint)
+    throw std::runtime_error(path + ": a checkpoint of another render (its scene file or an option that changes the "
+                             "image differs); delete it or name another file.\n  checkpoint: " + theirs +
+                             "\n  this run:   " + fingerprint);
+  driver.restore(in);
+  session.restore(in);
+  if (!in.at_end()) in.fail("bytes past the end");
+  return true;
+}
+
+}  // namespace pt
