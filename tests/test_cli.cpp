@@ -492,7 +492,7 @@ TEST(Checkpoint, AKilledRenderResumesToTheSameBits) {
   ASSERT_TRUE(std::regex_search(again.output, m, std::regex(R"(Resuming from \S+: ([0-9.]+) spp a pixel)"))) << again.output;
   EXPECT_GT(std::stod(m[1]), 0.0);
   EXPECT_LT(std::stod(m[1]), 1024.0) << "it resumed a render that had finished: nothing was tested";
-  EXPECT_NE(again.output.find("checkpoints written"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find(" written in "), std::string::npos) << again.output;
   const std::vector<float> a = exr_pixels(dir + "/whole.exr"), b = exr_pixels(dir + "/resumed.exr");
   ASSERT_FALSE(a.empty());
   ASSERT_EQ(a.size(), b.size());

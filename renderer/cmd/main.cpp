@@ -185,7 +185,8 @@ int main(int argc, char** argv) {
     const double err = session.error_estimate();
     const std::string err_text = format_error_estimate(err) + (std::isfinite(err) ? "" : " (needs 2 or more spp)");
     if (checkpoints > 0)
-      std::printf("%s: %d checkpoints written in %.3f s\n", o.checkpoint.c_str(), checkpoints, checkpoint_seconds);
+      std::printf("%s: %d checkpoint%s written in %.3f s\n", o.checkpoint.c_str(), checkpoints,
+                  checkpoints == 1 ? "" : "s", checkpoint_seconds);
     std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %s%s%s\n",
                 o.output.c_str(), session.width(), session.height(), st.samples / pixels, o.params.spp, st.seconds,
                 st.samples / st.seconds, st.rays / st.seconds, err_text.c_str(),
