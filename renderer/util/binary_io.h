@@ -22,7 +22,7 @@ class BinaryWriter {
   template <class T>
   void array(const std::vector<T>& v) {
     pod(uint64_t(v.size()));
-    m_out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    if (!v.empty()) m_out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
   }
   void text(const std::string& s) {
     pod(uint64_t(s.size()));
@@ -54,7 +54,7 @@ class BinaryReader {
     if (n != count) fail("an array of " + std::to_string(n) + " where " + std::to_string(count) + " belong");
     need(count * sizeof(T));
     v.resize(count);
-    std::memcpy(v.data(), m_in.data() + m_at, count * sizeof(T));
+    if (count) std::memcpy(v.data(), m_in.data() + m_at, count * sizeof(T));  // never memcpy to a null data()
     m_at += count * sizeof(T);
   }
   std::string text(size_t max_size) {
