@@ -64,7 +64,9 @@ PT_LANE float as_float(int32_t i) {
   return a;
 }
 PT_LANE float sqrt(float a) { return std::sqrt(a); }
-PT_LANE int32_t truncate(float a) { return int32_t(a); }
+// int32_t(a) as cvttss2si computes it, defined for NaN and out-of-range values too (INT32_MIN, as
+// the vector lanes' cvttps2dq), where the C++ conversion is undefined behaviour.
+PT_LANE int32_t truncate(float a) { return _mm_cvttss_si32(_mm_set_ss(a)); }
 PT_LANE float abs(float a) { return std::fabs(a); }
 PT_LANE float copysign(float a, float s) { return std::copysign(a, s); }
 PT_LANE bool is_finite(float a) { return std::isfinite(a); }
