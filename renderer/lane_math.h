@@ -50,6 +50,10 @@ PT_LANE void store_mask(int* p, bool a) { *p = a ? -1 : 0; }
 
 PT_LANE float select(bool m, float a, float b) { return m ? a : b; }
 PT_LANE int32_t select(bool m, int32_t a, int32_t b) { return m ? a : b; }
+// Two's-complement sum and negation, wrapping as the vector lanes' integer adds do (a signed
+// int32_t overflow would be undefined behaviour: INT32_MIN from a NaN's truncate reaches here).
+PT_LANE int32_t wrapping_add(int32_t a, int32_t b) { return int32_t(uint32_t(a) + uint32_t(b)); }
+PT_LANE int32_t wrapping_neg(int32_t a) { return int32_t(0u - uint32_t(a)); }
 PT_LANE Vec2 select(bool m, Vec2 a, Vec2 b) { return m ? a : b; }
 PT_LANE Vec3 select(bool m, Vec3 a, Vec3 b) { return m ? a : b; }
 
