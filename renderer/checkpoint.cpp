@@ -40,7 +40,8 @@ std::string render_fingerprint(const std::string& scene_bytes, const RenderParam
   const RunLimits none;
   for (const RenderOption& o : render_options()) {
     const std::string name = o.name;
-    if (name == "time_limit" || name == "target_error" || name == "tile_size") continue;
+    // Limits decide when a render stops, not its samples; a larger spp continues it (Film::restore).
+    if (name == "time_limit" || name == "target_error" || name == "tile_size" || name == "spp") continue;
     f << ", " << name << " " << option_text(o, o.get(p, none));
   }
   f << ", sampler " << int(p.sampler) << ", environment '" << p.env_map << "', camera file '" << p.camera_file
@@ -100,6 +101,18 @@ bool restore_checkpoint(const std::string& path, const std::string& fingerprint,
   driver.restore(in);
   session.restore(in);
   if (!in.at_end()) in.fail("bytes past the end");
+  driver.reopen();
+  return true;
+}
+
+bool Checkpointer::after_pass(const RenderSession& session, const ProgressiveDriver& driver, bool force) {
+  using clock = std::chrono::steady_clock;
+  const auto now = clock::now();
+  if (!force && std::chrono::duration<double>(now - m_last).count() < m_interval) return false;
+  save_checkpoint(m_path, m_fingerprint, session, driver);
+  m_last = clock::now();
+  m_save_seconds += std::chrono::duration<double>(m_last - now).count();
+  ++m_saves;
   return true;
 }
 

@@ -5,6 +5,7 @@
 // uninterrupted render's, bit for bit.
 #pragma once
 
+#include <chrono>
 #include <string>
 
 #include "session.h"
@@ -22,5 +23,30 @@ void save_checkpoint(const std::string& path, const std::string& fingerprint, co
 // std::runtime_error naming the file when it is not a checkpoint of this render or is damaged.
 bool restore_checkpoint(const std::string& path, const std::string& fingerprint, RenderSession& session,
                         ProgressiveDriver& driver);
+
+// Checkpoints of one render at pass ends: the CLI's --checkpoint and the job service's jobs.
+class Checkpointer {
+ public:
+  // Saves to `path` at most every `interval` seconds (0: after every pass).
+  Checkpointer(std::string path, std::string fingerprint, double interval)
+      : m_path(std::move(path)), m_fingerprint(std::move(fingerprint)), m_interval(interval) {}
+  // restore_checkpoint into a fresh session and driver.
+  bool restore(RenderSession& session, ProgressiveDriver& driver) const {
+    return restore_checkpoint(m_path, m_fingerprint, session, driver);
+  }
+  // After a pass: saves when `force` is set or the interval has passed since the last save.
+  // Returns whether it saved.
+  bool after_pass(const RenderSession& session, const ProgressiveDriver& driver, bool force = false);
+  const std::string& path() const { return m_path; }
+  int saves() const { return m_saves; }
+  double save_seconds() const { return m_save_seconds; }  // time spent saving, in all
+
+ private:
+  std::string m_path, m_fingerprint;
+  double m_interval;
+  std::chrono::steady_clock::time_point m_last = std::chrono::steady_clock::now();
+  int m_saves = 0;
+  double m_save_seconds = 0;
+};
 
 }  // namespace pt

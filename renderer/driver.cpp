@@ -71,12 +71,19 @@ void ProgressiveDriver::save(BinaryWriter& out) const {
 void ProgressiveDriver::restore(BinaryReader& in) {
   const int32_t target = in.pod<int32_t>();
   const uint8_t done = in.pod<uint8_t>(), reason = in.pod<uint8_t>();
-  if (target < 1 || target > m_source.film().spp() || done > 1 || reason > uint8_t(StopReason::cancelled))
+  // A target past this film's budget is the film's to refuse (Film::restore names the budgets).
+  if (target < 1 || target > (1 << 24) || done > 1 || reason > uint8_t(StopReason::cancelled))
     in.fail("an impossible pass target or stop");
   // A render that spent its budget stays done; one that stopped at a limit runs its last pass
   // again (a pass with nothing to add) and lets the limits it runs under now decide.
   m_target = target, m_reason = StopReason(reason);
   m_done = done != 0 && m_reason == StopReason::finished;
+}
+
+void ProgressiveDriver::reopen() {
+  if (!m_done || m_source.finished()) return;
+  m_done = false;
+  m_target = next_pass_target(m_target, m_source.film().spp(), INFINITY, 0);
 }
 
 StopReason run_progressive(PassSource& source, const RunLimits& limits, const std::atomic<bool>* cancel,

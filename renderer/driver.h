@@ -69,6 +69,9 @@ class ProgressiveDriver {
   // Checkpoints (checkpoint.h): the next pass's target and whether the render has ended.
   void save(BinaryWriter& out) const;
   void restore(BinaryReader& in);
+  // After a restore into a larger budget (a render continued): a render that had finished its old
+  // budget takes the next pass towards the new one.
+  void reopen();
 
  private:
   PassSource& m_source;

@@ -183,8 +183,12 @@ void Film::save(BinaryWriter& out) const {
 void Film::restore(BinaryReader& in) {
   const int32_t w = in.pod<int32_t>(), h = in.pod<int32_t>(), spp = in.pod<int32_t>();
   const bool caustics = in.pod<uint8_t>() != 0;
-  if (w != m_w || h != m_h || spp != m_spp || caustics != has_caustics())
-    in.fail("a " + std::to_string(w) + "x" + std::to_string(h) + " film of " + std::to_string(spp) + " spp");
+  if (w != m_w || h != m_h || caustics != has_caustics())
+    in.fail("a " + std::to_string(w) + "x" + std::to_string(h) + " film" + (caustics ? " with" : " without") +
+            " light-traced caustics");
+  if (spp < 1 || spp > m_spp)
+    in.fail("a film of " + std::to_string(spp) + " spp, more than this render's " + std::to_string(m_spp) +
+            " (a budget can grow, not shrink)");
   const size_t n = pixels(), lt = caustics ? n : 0;
   in.array(m_sum, n), in.array(m_s1, n), in.array(m_s2, n), in.array(m_half_s1, n), in.array(m_half_n, n);
   in.array(m_count, n), in.array(m_done, n);
@@ -192,11 +196,17 @@ void Film::restore(BinaryReader& in) {
   in.array(m_lt_sum, lt), in.array(m_lt_s1, lt), in.array(m_lt_half_s1, lt);
   m_lt_paths = in.pod<uint64_t>(), m_lt_half_paths = in.pod<uint64_t>();
   for (size_t i = 0; i < n; ++i)
-    if (m_count[i] > uint32_t(m_spp) || m_half_n[i] > m_count[i] || m_done[i] > 1 || !is_finite(m_sum[i]) ||
+    if (m_count[i] > uint32_t(spp) || m_half_n[i] > m_count[i] || m_done[i] > 1 || !is_finite(m_sum[i]) ||
         !std::isfinite(m_s1[i]) || !std::isfinite(m_s2[i]) || !std::isfinite(m_half_s1[i]) ||
         (caustics && (!is_finite(m_lt_sum[i]) || !std::isfinite(m_lt_s1[i]) || !std::isfinite(m_lt_half_s1[i]))))
       in.fail("pixel " + std::to_string(i) + " holds impossible values");
   if (m_lt_half_paths > m_lt_paths) in.fail("more light paths in a part than in all");
+  // A larger budget reopens the pixels the old one stopped, unless the adaptive rule stops them at
+  // that count too: as a render with this budget from the start would have.
+  if (spp < m_spp)
+    for (size_t i = 0; i < n; ++i)
+      if (m_done[i] && m_count[i] >= uint32_t(spp) && !(m_rule.test_due(m_count[i]) && m_rule.converged(m_s1[i], m_s2[i], m_count[i])))
+        m_done[i] = 0;
   m_estimate.invalidate();
 }
 

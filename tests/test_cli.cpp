@@ -503,6 +503,30 @@ TEST(Checkpoint, AKilledRenderResumesToTheSameBits) {
   EXPECT_EQ(exr_pixels(dir + "/resumed.exr"), b);
 }
 
+// A finished render's checkpoint continues under a larger -s: the image is the larger budget's render
+// from the start, bit for bit (the adaptive rule's stops included); a smaller -s is refused.
+TEST(Checkpoint, ALargerBudgetContinuesAFinishedRender) {
+  const std::string dir = test::temp_dir() + "/checkpoint_more", scene = test::own_scene("cornell.dae");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string flags = "-t 2 -m 4 -r 48 36 -a 4 0.15 --seed 3 --quiet ", ck = " --checkpoint " + dir + "/c.ckpt";
+  RunResult whole = run(flags + "-s 64 -f " + dir + "/whole.exr " + scene);
+  ASSERT_EQ(whole.status, 0) << whole.output;
+  RunResult first = run(flags + "-s 16" + ck + " -f " + dir + "/more.exr " + scene);
+  ASSERT_EQ(first.status, 0) << first.output;
+  const std::vector<float> sixteen = exr_pixels(dir + "/more.exr");
+  RunResult more = run(flags + "-s 64" + ck + " -f " + dir + "/more.exr " + scene);
+  ASSERT_EQ(more.status, 0) << more.output;
+  const std::vector<float> a = exr_pixels(dir + "/whole.exr"), b = exr_pixels(dir + "/more.exr");
+  ASSERT_FALSE(a.empty());
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_NE(sixteen, b) << "the larger budget added nothing";
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << "the continued image differs";
+  RunResult fewer = run(flags + "-s 8" + ck + " -f " + dir + "/x.exr " + scene);
+  EXPECT_EQ(fewer.status, 1);
+  EXPECT_NE(fewer.output.find("a budget can grow, not shrink"), std::string::npos) << fewer.output;
+}
+
 // A checkpoint belongs to one render: another option that changes the image, another scene, a file
 // that is not a checkpoint or is cut short are refused with a message naming the file.
 TEST(Checkpoint, AnotherRendersOrADamagedCheckpointIsRefused) {

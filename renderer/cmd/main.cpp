@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <new>
 #include <string>
 
@@ -147,29 +148,21 @@ int main(int argc, char** argv) {
     };
     // The driver stepped here rather than by run_progressive: a checkpoint goes between passes.
     ProgressiveDriver driver(session, o.limits);
-    std::string fingerprint;
+    std::unique_ptr<Checkpointer> checkpoints;
     if (!o.checkpoint.empty()) {
       std::ifstream scene_file(o.scene_path, std::ios::binary);
-      fingerprint = render_fingerprint(std::string(std::istreambuf_iterator<char>(scene_file), {}), o.params);
-      if (restore_checkpoint(o.checkpoint, fingerprint, session, driver) && !o.quiet)
+      checkpoints = std::make_unique<Checkpointer>(
+          o.checkpoint, render_fingerprint(std::string(std::istreambuf_iterator<char>(scene_file), {}), o.params),
+          o.checkpoint_interval);
+      if (checkpoints->restore(session, driver) && !o.quiet)
         std::fprintf(stderr, "Resuming from %s: %.1f spp a pixel, %.2f s rendered\n", o.checkpoint.c_str(),
                      session.stats().samples / pixels, session.seconds());
     }
-    int checkpoints = 0;
-    double checkpoint_seconds = 0;
-    auto last_checkpoint = std::chrono::steady_clock::now();
     while (!driver.done()) {
       const PassReport r = driver.step(nullptr, on_tile);
       on_pass(r);
       if (!r.completed) break;  // the time limit cut the pass: the last checkpoint is the last whole pass
-      const auto now = std::chrono::steady_clock::now();
-      if (!o.checkpoint.empty() &&
-          (driver.done() || std::chrono::duration<double>(now - last_checkpoint).count() >= o.checkpoint_interval)) {
-        save_checkpoint(o.checkpoint, fingerprint, session, driver);
-        last_checkpoint = std::chrono::steady_clock::now();
-        checkpoint_seconds += std::chrono::duration<double>(last_checkpoint - now).count();
-        ++checkpoints;
-      }
+      if (checkpoints) checkpoints->after_pass(session, driver, driver.done());
     }
     const StopReason why = driver.reason();
     bar.finish();
@@ -184,9 +177,9 @@ int main(int argc, char** argv) {
     // The estimate compares two halves of each pixel's samples: with one sample a pixel there is none.
     const double err = session.error_estimate();
     const std::string err_text = format_error_estimate(err) + (std::isfinite(err) ? "" : " (needs 2 or more spp)");
-    if (checkpoints > 0)
-      std::printf("%s: %d checkpoint%s written in %.3f s\n", o.checkpoint.c_str(), checkpoints,
-                  checkpoints == 1 ? "" : "s", checkpoint_seconds);
+    if (checkpoints && checkpoints->saves() > 0)
+      std::printf("%s: %d checkpoint%s written in %.3f s\n", o.checkpoint.c_str(), checkpoints->saves(),
+                  checkpoints->saves() == 1 ? "" : "s", checkpoints->save_seconds());
     std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %s%s%s\n",
                 o.output.c_str(), session.width(), session.height(), st.samples / pixels, o.params.spp, st.seconds,
                 st.samples / st.seconds, st.rays / st.seconds, err_text.c_str(),
