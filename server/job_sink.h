@@ -17,13 +17,13 @@ class JobStateSink : public JobSink {
  public:
   JobStateSink(Job& job, std::function<void(Job&)> persist) : m_job(job), m_persist(std::move(persist)) {}
 
-  void started(int width, int height, const std::vector<std::string>& features) override {
+  void started(int width, int height, const std::vector<std::string>& features, double resumed_seconds) override {
     Job& j = m_job;
     {
       std::lock_guard<std::mutex> lock(j.mutex);
       if (j.cancel) throw JobError(JobErrorKind::conflict, "cancelled");
       j.state = JobState::running;
-      j.started_at = now_unix_seconds();
+      if (j.started_at <= 0 || resumed_seconds <= 0) j.started_at = now_unix_seconds();
       j.width = width;
       j.height = height;
       j.tile_size = j.spec.params.tile_size;
@@ -34,13 +34,15 @@ class JobStateSink : public JobSink {
       j.linear.assign(n * 3, 0.0f);
       j.display.assign(n * 3, 0);
       j.region_version.assign(size_t(j.regions_x) * j.regions_y, 0);
+      // A resumed render keeps its history up to the checkpoint; its first pass() brings the counts.
       j.samples = 0;
-      j.history.clear();
+      while (!j.history.empty() && !(j.history.back().seconds <= resumed_seconds)) j.history.pop_back();
       j.has_image = false;
       j.features = features;
       ++j.version;
       m_persist(j);
     }
+    m_offset = resumed_seconds;
     m_start = std::chrono::steady_clock::now();
     m_last_persist = m_start;
     j.changed.notify_all();
@@ -97,8 +99,19 @@ class JobStateSink : public JobSink {
     j.changed.notify_all();
   }
 
+  void checkpointed(uint64_t samples, double seconds) override {
+    std::lock_guard<std::mutex> lock(m_job.mutex);
+    m_job.checkpoint_samples = samples;
+    m_job.checkpoint_seconds = seconds;
+    m_persist(m_job);
+  }
+
  private:
-  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count(); }
+  // Rendering time: a resumed render's counts on from its checkpoint's.
+  double seconds() const {
+    return m_offset + std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+  }
+  double m_offset = 0;
   Job& m_job;
   std::function<void(Job&)> m_persist;
   std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last_persist = m_start;

@@ -70,6 +70,7 @@ const char* job_state_name(JobState s) {
   switch (s) {
     case JobState::queued: return "queued";
     case JobState::running: return "running";
+    case JobState::paused: return "paused";
     case JobState::done: return "done";
     case JobState::failed: return "failed";
     case JobState::cancelled: return "cancelled";
@@ -78,7 +79,8 @@ const char* job_state_name(JobState s) {
 }
 
 bool parse_job_state(const std::string& s, JobState* out) {
-  for (JobState st : {JobState::queued, JobState::running, JobState::done, JobState::failed, JobState::cancelled})
+  for (JobState st : {JobState::queued, JobState::running, JobState::paused, JobState::done, JobState::failed,
+                      JobState::cancelled})
     if (s == job_state_name(st)) {
       *out = st;
       return true;
@@ -197,30 +199,6 @@ std::vector<std::shared_ptr<Job>> JobManager::list() const {
   return out;
 }
 
-void JobManager::cancel(const std::string& id) {
-  auto job = get(id);
-  if (!job) throw JobError(JobErrorKind::not_found, "no job '" + id + "'");
-  {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    auto it = std::find(m_queue.begin(), m_queue.end(), job);
-    if (it != m_queue.end()) {
-      m_queue.erase(it);
-      std::lock_guard<std::mutex> jl(job->mutex);
-      job->state = JobState::cancelled;
-      job->finished_at = now_unix_seconds();
-      ++job->version;
-      persist(*job);
-      job->changed.notify_all();
-      return;
-    }
-  }
-  std::lock_guard<std::mutex> jl(job->mutex);
-  if (is_final(job->state))
-    throw JobError(JobErrorKind::conflict, std::string("job is already ") + job_state_name(job->state));
-  job->cancel = true;  // the worker stops within a few samples and marks it cancelled
-  job->halt = true;
-}
-
 json JobManager::status_json(const Job& j, bool with_history) const {
   json s{{"id", j.id},
          {"url", "/api/jobs/" + j.id},
@@ -230,7 +208,8 @@ json JobManager::status_json(const Job& j, bool with_history) const {
          {"samples", j.samples},
          {"spp_done", j.width > 0 ? double(j.samples) / (double(j.width) * j.height) : 0.0},
          {"elapsed", j.elapsed},
-         {"eta", j.eta >= 0 ? json(j.eta) : json(nullptr)},
+         // Only a live job has an ETA: a cancelled or paused one is not on its way anywhere.
+         {"eta", j.eta >= 0 && (j.state == JobState::running || j.state == JobState::queued) ? json(j.eta) : json(nullptr)},
          {"error_estimate", j.error_estimate >= 0 ? json(j.error_estimate) : json(nullptr)},
          {"nonfinite_samples", j.nonfinite},
          {"rays", j.rays},
@@ -245,6 +224,10 @@ json JobManager::status_json(const Job& j, bool with_history) const {
          {"images", {{"png", "/api/jobs/" + j.id + "/image.png"}, {"exr", "/api/jobs/" + j.id + "/image.exr"}}},
          {"events", "/api/jobs/" + j.id + "/events"}};
   if (!j.message.empty()) s["message"] = j.message;
+  if (!j.stopped.empty()) s["stopped"] = j.stopped;
+  // A kept film (its checkpoint): a done or cancelled job can be continued, a paused one resumed.
+  s["can_continue"] = (j.state == JobState::done || j.state == JobState::cancelled) &&
+                      is_regular_file(checkpoint_path(j.id));
   if (with_history) {
     json h = json::array();
     for (const ErrorPoint& p : j.history) h.push_back({{"seconds", p.seconds}, {"spp", p.spp}, {"error", p.error}});
@@ -274,6 +257,7 @@ double JobManager::focus_distance(const Job& job, double x, double y) {
 void JobManager::write_job_file(Job& j) {
   json doc = status_json(j);
   doc["idempotency_key"] = j.idempotency_key;
+  doc["checkpoint"] = {{"samples", j.checkpoint_samples}, {"seconds", j.checkpoint_seconds}};
   write_file_atomic(job_dir(j.id) + "/job.json", dump_json(doc, 1));
 }
 
@@ -329,9 +313,10 @@ void JobManager::load_persisted() {
           st = JobState::queued;
         }
       }
-      if (st == JobState::running) st = JobState::queued;  // interrupted: run again
+      if (st == JobState::running) st = JobState::queued;  // interrupted: run again, from its checkpoint
       job->state = st;
-      if (st != JobState::queued) {
+      {  // every job's counts and history: a resumed one shows its checkpoint's until its first pass
+        job->stopped = to_valid_utf8(doc.value("stopped", ""));
         job->message = to_valid_utf8(doc.value("message", ""));
         job->progress = doc.value("progress", 0.0);
         job->samples = doc.value("samples", uint64_t(0));
@@ -348,6 +333,17 @@ void JobManager::load_persisted() {
             if (f.is_string()) job->features.push_back(to_valid_utf8(f.get<std::string>()));
         job->width = job->spec.params.width;
         job->height = job->spec.params.height;
+        if (doc.contains("checkpoint") && doc["checkpoint"].is_object()) {
+          job->checkpoint_samples = doc["checkpoint"].value("samples", uint64_t(0));
+          job->checkpoint_seconds = doc["checkpoint"].value("seconds", 0.0);
+        }
+        if (st == JobState::queued) {  // interrupted: it shows what its checkpoint holds, what it resumes from
+          const bool kept = is_regular_file(checkpoint_path(id));
+          job->samples = kept ? job->checkpoint_samples : 0;
+          job->elapsed = kept ? job->checkpoint_seconds : 0;
+          while (!job->history.empty() && !(job->history.back().seconds <= job->elapsed)) job->history.pop_back();
+          job->eta = -1, job->finished_at = 0;
+        }
       }
       m_jobs[id] = job;
       if (!job->idempotency_key.empty()) m_idempotency[job->idempotency_key] = id;
@@ -378,77 +374,96 @@ void JobManager::worker_loop() {
 }
 
 void JobManager::run_job(const std::shared_ptr<Job>& job) {
-  auto notify = [&] { job->changed.notify_all(); };
   try {
-    // One flag stops the render: a user's cancel or the server's shutdown set it directly (the
-    // time limit and the error target are the backend's).
-    job->halt = job->cancel || m_stopping;
+    // One flag stops the render: a user's cancel or pause, or the server's shutdown, set it
+    // directly (the time limit and the error target are the backend's).
+    job->halt = job->cancel || job->pause || m_stopping;
     JobStateSink sink(*job, [this](Job& j) { persist(j); });
-    RenderResult result = m_backend->render(*job, sink, job->halt);
-
-    if (m_stopping && !job->cancel) {  // shutdown: run it again after a restart
+    RenderResult result =
+        m_backend->render(*job, sink, job->halt, {checkpoint_path(job->id), m_config.checkpoint_interval});
+    if (result.why == pt::StopReason::cancelled) {
+      if (job->cancel) store_images(*job, result);  // what a cancelled job had rendered can be downloaded
       std::lock_guard<std::mutex> lock(job->mutex);
-      job->state = JobState::queued;
-      job->progress = 0;
-      ++job->version;
-      persist(*job);
-      notify();
-      return;
-    }
-    if (job->cancel) {
-      std::lock_guard<std::mutex> lock(job->mutex);
-      job->state = JobState::cancelled;
-      job->finished_at = now_unix_seconds();
-      ++job->version;
-      persist(*job);
-      notify();
+      settle_stopped(*job, result);
       return;
     }
     // Finished (sample budget, error target or time limit): images first, then the state.
-    const pt::ImageRGB& img = result.image;
+    store_images(*job, result);
     const RenderReport& r = result.report;
-    pt::Metadata meta{{"pathtracer:scene", job->spec.scene},
-                      {"pathtracer:job", job->id},
-                      {"pathtracer:spec", dump_json(job_spec_to_json(job->spec))},
-                      {"pathtracer:achieved_spp", std::to_string(double(r.samples) / (double(img.width) * img.height))},
-                      {"pathtracer:wall_seconds", std::to_string(result.seconds)},
-                      {"pathtracer:error_estimate", std::to_string(r.error)},
-                      {"pathtracer:seed", std::to_string(job->spec.params.seed)},
-                      {"pathtracer:nonfinite_samples", std::to_string(r.nonfinite)},
-                      {"pathtracer:backend", m_backend->name()}};
-    try {
-      // Each file is read back and compared before its rename (pt::write_image); a write that fails
-      // for want of a descriptor (a connection flood) is retried rather than losing the render.
-      retry_without_descriptors([&] { pt::write_image(img, job_dir(job->id) + "/image.exr", meta); });
-      retry_without_descriptors([&] { pt::write_image(img, job_dir(job->id) + "/image.png"); });
-    } catch (const std::exception& e) {  // a full disk or a vanished data directory: the job fails, saying so
-      std::string why = e.what(), dir = job_dir(job->id) + "/";
-      for (size_t at; (at = why.find(dir)) != std::string::npos;) why.erase(at, dir.size());  // no server paths
-      throw std::runtime_error("cannot store the finished image: " + why);
+    {
+      std::lock_guard<std::mutex> lock(job->mutex);
+      job->state = JobState::done;
+      job->stopped = pt::stop_reason_name(result.why);
+      job->progress = 1;
+      job->eta = -1;
+      job->samples = r.samples;
+      job->rays = r.rays;
+      job->nonfinite = r.nonfinite;
+      job->finished_at = now_unix_seconds();
+      ++job->version;
+      persist(*job);
     }
-    std::lock_guard<std::mutex> lock(job->mutex);
-    job->state = JobState::done;
-    job->progress = 1;
-    job->eta = 0;
-    job->samples = r.samples;
-    job->rays = r.rays;
-    job->nonfinite = r.nonfinite;
-    job->finished_at = now_unix_seconds();
-    ++job->version;
-    persist(*job);
-    notify();
+    job->changed.notify_all();
   } catch (const std::exception& e) {
-    std::lock_guard<std::mutex> lock(job->mutex);
-    job->state = job->cancel ? JobState::cancelled : JobState::failed;
-    if (!job->cancel)  // bad_alloc's what() says only "std::bad_alloc"
-      job->message = dynamic_cast<const std::bad_alloc*>(&e)
-                         ? "out of memory for a " + std::to_string(job->spec.params.width) + "x" +
-                               std::to_string(job->spec.params.height) + " image; a smaller size needs less"
-                         : to_valid_utf8(e.what());
-    job->finished_at = now_unix_seconds();
-    ++job->version;
-    persist(*job);
-    notify();
+    {
+      std::lock_guard<std::mutex> lock(job->mutex);
+      job->state = job->cancel ? JobState::cancelled : JobState::failed;
+      if (!job->cancel)  // bad_alloc's what() says only "std::bad_alloc"
+        job->message = dynamic_cast<const std::bad_alloc*>(&e)
+                           ? "out of memory for a " + std::to_string(job->spec.params.width) + "x" +
+                                 std::to_string(job->spec.params.height) + " image; a smaller size needs less"
+                           : to_valid_utf8(e.what());
+      job->eta = -1;
+      job->finished_at = now_unix_seconds();
+      ++job->version;
+      persist(*job);
+    }
+    job->changed.notify_all();
+  }
+  enforce_retention();
+}
+
+void JobManager::settle_stopped(Job& job, const RenderResult& result) {
+  job.eta = -1;
+  job.samples = result.report.samples;
+  if (job.cancel) {
+    job.state = JobState::cancelled;
+    job.stopped = pt::stop_reason_name(pt::StopReason::cancelled);
+    job.finished_at = now_unix_seconds();
+  } else if (job.pause) {
+    job.state = JobState::paused;
+  } else {
+    job.state = JobState::queued;  // the server is stopping: a restart continues it from its checkpoint
+  }
+  ++job.version;
+  persist(job);
+  job.changed.notify_all();
+}
+
+// Each file is read back and compared before its rename (pt::write_image); a write that fails for
+// want of a descriptor (a connection flood) is retried rather than losing the render.
+void JobManager::store_images(Job& job, const RenderResult& result) {
+  const pt::ImageRGB& img = result.image;
+  if (img.pixels.empty()) return;
+  const RenderReport& r = result.report;
+  pt::Metadata meta{{"pathtracer:scene", job.spec.scene},
+                    {"pathtracer:job", job.id},
+                    {"pathtracer:spec", dump_json(job_spec_to_json(job.spec))},
+                    {"pathtracer:achieved_spp", std::to_string(double(r.samples) / (double(img.width) * img.height))},
+                    {"pathtracer:wall_seconds", std::to_string(result.seconds)},
+                    {"pathtracer:error_estimate", std::to_string(r.error)},
+                    {"pathtracer:seed", std::to_string(job.spec.params.seed)},
+                    {"pathtracer:nonfinite_samples", std::to_string(r.nonfinite)},
+                    {"pathtracer:stopped", pt::stop_reason_name(result.why)},
+                    {"pathtracer:backend", m_backend->name()}};
+  try {
+    retry_without_descriptors([&] { pt::write_image(img, job_dir(job.id) + "/image.exr", meta); });
+    retry_without_descriptors([&] { pt::write_image(img, job_dir(job.id) + "/image.png"); });
+  } catch (const std::exception& e) {  // a full disk or a vanished data directory: the job fails, saying so
+    std::string why = e.what(), dir = job_dir(job.id) + "/";
+    for (size_t at; (at = why.find(dir)) != std::string::npos;) why.erase(at, dir.size());  // no server paths
+    throw std::runtime_error("cannot store the " + std::string(job.cancel ? "cancelled job's" : "finished") +
+                             " image: " + why);
   }
 }
 

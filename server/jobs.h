@@ -19,11 +19,13 @@
 namespace srv {
 
 class RenderBackend;
+struct RenderResult;
 
 // Seconds since the Unix epoch: the job timestamps' clock.
 double now_unix_seconds();
 
-enum class JobState { queued, running, done, failed, cancelled };
+// paused: stopped by a user with its film kept (its checkpoint); resumed, it queues again.
+enum class JobState { queued, running, paused, done, failed, cancelled };
 const char* job_state_name(JobState s);
 bool parse_job_state(const std::string& s, JobState* out);
 inline bool is_final(JobState s) { return s == JobState::done || s == JobState::failed || s == JobState::cancelled; }
@@ -42,17 +44,21 @@ struct Job {
   JobSpec spec;
   std::string idempotency_key;
   std::atomic<bool> cancel{false};
-  std::atomic<bool> halt{false};  // stops its render: set by a cancel or the server's shutdown
+  std::atomic<bool> pause{false};
+  std::atomic<bool> halt{false};  // stops its render: set by a cancel, a pause or the server's shutdown
 
   mutable std::mutex mutex;
   std::condition_variable changed;
   uint64_t version = 1;  // bumps on every change; also the SSE event id
   JobState state = JobState::queued;
   std::string message;   // why it failed
+  std::string stopped;   // why its last render ended (pt::stop_reason_name), "" before the first
   double created_at = 0, started_at = 0, finished_at = 0;  // unix seconds
   double progress = 0, elapsed = 0, eta = -1, error_estimate = -1;
   uint64_t samples = 0, rays = 0, nonfinite = 0;
   std::vector<ErrorPoint> history;
+  uint64_t checkpoint_samples = 0;  // what the job's checkpoint holds (a restart shows these)
+  double checkpoint_seconds = 0;
   std::vector<std::string> features;
 
   // The live image: linear RGB and its 8-bit display version. Clients are sent it in regions of at
@@ -77,6 +83,16 @@ struct ManagerConfig {
   std::string queue = "embedded";  // or redis://host:port: render-workers do the rendering
   int units_in_flight = 4;         // Redis: sample passes queued ahead of the merges, per job
   double redis_timeout = 300;      // Redis: seconds a job waits for an unreachable Redis
+  double checkpoint_interval = 30; // seconds between a running job's checkpoints (0: every pass)
+  size_t keep_jobs = 0;            // finished jobs kept; past it the oldest are deleted (0: all)
+  uint64_t max_data_bytes = 0;     // the data folder's size past which finished jobs are deleted (0: no cap)
+};
+
+// A page of the job list: newest first, `limit` jobs created before the job `cursor` ("" for the
+// newest), in `state` (all states when empty).
+struct JobPage {
+  std::vector<std::shared_ptr<Job>> jobs;
+  std::string next_cursor;  // "" on the last page
 };
 
 class JobManager {
@@ -95,8 +111,24 @@ class JobManager {
   JobSpec check(const json& body) const;
   std::shared_ptr<Job> get(const std::string& id) const;
   std::vector<std::shared_ptr<Job>> list() const;
-  // Cancels a queued or running job; throws JobError(conflict) for a finished one.
+  JobPage page(size_t limit, const std::string& cursor, const std::string& state) const;
+
+  // ---- control (job_control.cpp); each throws JobError(not_found) for no such job ----
+  // Cancels a queued, running or paused job and waits (a few seconds at most) for it to settle;
+  // throws JobError(conflict) for a finished one.
   void cancel(const std::string& id);
+  // A running job stops with its film kept (a checkpoint), a queued one leaves the queue: both are
+  // then paused. Conflict for a finished job.
+  void pause(const std::string& id);
+  // A paused job queues again, to continue from its checkpoint. Conflict for any other state.
+  void resume(const std::string& id);
+  // Takes a done or cancelled job further from its film: `body` may raise `spp` and set a new
+  // `target_error`, or a `time_limit` of more seconds. Conflict without a kept film.
+  void continue_job(const std::string& id, const json& body);
+  // Deletes a finished job and its files (true), or cancels a live one (false).
+  bool remove(const std::string& id);
+  // The data folder's size in bytes (job files, checkpoints included).
+  uint64_t data_bytes() const;
 
   json status_json(const Job& job, bool with_history = true) const;  // job.mutex must be held
   // Distance from the job's camera through pixel (x, y) (top-left origin) to the first surface;
@@ -107,11 +139,20 @@ class JobManager {
   int live_workers() const;  // -1 for the embedded backend
   SceneLibrary& scenes() { return m_scenes; }
   std::string job_dir(const std::string& id) const;
+  std::string checkpoint_path(const std::string& id) const { return job_dir(id) + "/checkpoint.bin"; }
   bool stopping() const { return m_stopping.load(); }
 
  private:
   void worker_loop();
   void run_job(const std::shared_ptr<Job>& job);
+  // Ends a render that stopped without finishing: paused, queued again (shutdown) or cancelled.
+  void settle_stopped(Job& job, const RenderResult& result);  // job.mutex must be held
+  void store_images(Job& job, const RenderResult& result);
+  // Waits up to `seconds` for the job's state to satisfy `settled`.
+  void wait_settled(Job& job, double seconds, bool (*settled)(JobState));
+  // Deletes the oldest finished jobs past --keep-jobs or --max-data-mb.
+  void enforce_retention();
+  void delete_files(const std::string& id);
   void persist(Job& job);         // job.mutex must be held; a failure is logged
   void write_job_file(Job& job);  // job.mutex must be held; throws on failure
   void load_persisted();

@@ -39,6 +39,12 @@ const char* kUsage =
     "  --units-in-flight N  Redis: passes queued ahead of the merges per job (default 4; about\n"
     "                    the number of workers)\n"
     "  --redis-timeout SEC  Redis: seconds a job waits for an unreachable Redis, then fails (default 300)\n"
+    "  --checkpoint-interval SEC  seconds between a running job's checkpoints, which a restart, a\n"
+    "                    pause or a continue resumes exactly (default 30; 0 = after every pass)\n"
+    "  --keep-jobs N     keep the newest N finished jobs; older ones are deleted with their files\n"
+    "                    (default 0: keep all). Queued, running and paused jobs are never deleted\n"
+    "  --max-data-mb M   delete the oldest finished jobs while the data folder is over M MiB\n"
+    "                    (default 0: no cap)\n"
     "  --token T         require 'Authorization: Bearer T' on /api (all but /api/health); also read\n"
     "                    from the environment variable RENDER_SERVER_TOKEN. The page asks for it.\n"
     "  --max-connections N  open connections before new ones are answered 503 (default 128; kept\n"
@@ -144,6 +150,14 @@ int main(int argc, char** argv) {
     else if (a == "--queue") cfg.queue = value();
     else if (a == "--units-in-flight") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.units_in_flight = int(n); }
     else if (a == "--redis-timeout") { const char* v = value(); if (!parse_seconds(v, &cfg.redis_timeout)) bad(v); }
+    else if (a == "--checkpoint-interval") {
+      const char* v = value();
+      char* end;
+      cfg.checkpoint_interval = std::strtod(v, &end);
+      if (*v == '\0' || *end != '\0' || !(cfg.checkpoint_interval >= 0 && cfg.checkpoint_interval <= 86400)) bad(v);
+    }
+    else if (a == "--keep-jobs") { const char* v = value(); if (!parse_int(v, 0, 100000000, &n)) bad(v); cfg.keep_jobs = size_t(n); }
+    else if (a == "--max-data-mb") { const char* v = value(); if (!parse_int(v, 0, 1L << 40, &n)) bad(v); cfg.max_data_bytes = uint64_t(n) << 20; }
     else if (a == "--token") api.token = value();
     else if (a == "--max-connections") { const char* v = value(); if (!parse_int(v, 1, 10000, &n)) bad(v); api.limits.max_connections = int(n); }
     else if (a == "--read-timeout") { const char* v = value(); if (!parse_seconds(v, &api.limits.request_timeout)) bad(v); }

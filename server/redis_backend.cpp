@@ -223,7 +223,7 @@ bool WorkerPasses::merge(const RedisReply& r) {
     for (uint32_t n : pass.samples) pass_samples += n;
     m_plan.observe(pass_samples, pass.seconds);
     if (!m_started) {
-      m_sink.started(m_w, m_h, parse_features(body.field("features")));
+      m_sink.started(m_w, m_h, parse_features(body.field("features")), 0);
       m_started = true;
     }
     m_film.merge(pass);
@@ -263,7 +263,7 @@ bool WorkerPasses::advance(int, const std::atomic<bool>* cancel, const pt::TileC
 }
 
 void WorkerPasses::finish(pt::StopReason why) {
-  if (!m_started && why != pt::StopReason::cancelled) m_sink.started(m_w, m_h, {});
+  if (!m_started && why != pt::StopReason::cancelled) m_sink.started(m_w, m_h, {}, 0);
   if (m_merged.empty()) return;
   std::string sizes;
   for (size_t u = 0; u < m_plan.issued(); ++u) sizes += (u ? " " : "") + std::to_string(m_plan.range(u).second);
@@ -294,7 +294,7 @@ class RedisBackend : public RenderBackend {
     }
   }
 
-  RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop) override {
+  RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop, const CheckpointPlan&) override {
     const JobSpec& spec = job.spec;
     std::string path = m_scenes.resolve(spec.scene), scene_text;
     if (path.empty() || !read_file(path, scene_text)) throw std::runtime_error("scene '" + spec.scene + "' is gone");

@@ -25,13 +25,15 @@ struct RenderReport {
 class JobSink {
  public:
   virtual ~JobSink() = default;
-  // Once, before any tile: the film size and the scene's feature set. Throws if the job was
-  // cancelled meanwhile.
-  virtual void started(int width, int height, const std::vector<std::string>& features) = 0;
+  // Once, before any tile: the film size and the scene's feature set, and the rendering time a
+  // checkpoint restored (0 for a fresh render). Throws if the job was cancelled meanwhile.
+  virtual void started(int width, int height, const std::vector<std::string>& features, double resumed_seconds) = 0;
   // A tile's pixels (mean radiance, row by row) changed. May be called from several threads.
   virtual void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean) = 0;
   // After each pass (a doubling pass, or a merged worker pass).
   virtual void pass(const RenderReport& r) = 0;
+  // A checkpoint now holds `samples` taken in `seconds` of rendering: what a restart resumes from.
+  virtual void checkpointed(uint64_t samples, double seconds) = 0;
 };
 
 struct RenderResult {
@@ -41,12 +43,21 @@ struct RenderResult {
   double seconds = 0;  // rendering time
 };
 
+// Where a job's render keeps its checkpoints (renderer/checkpoint.h): a render starts from the file
+// when it holds this job's film, saves it at pass ends every `interval` seconds, and always when it
+// ends, so that a restart, a pause or a continue takes it on exactly.
+struct CheckpointPlan {
+  std::string path;  // "" for none
+  double interval = 30;
+};
+
 class RenderBackend {
  public:
   virtual ~RenderBackend() = default;
   // Renders the job until its budget, error target or time limit, or until `stop` is set (then
   // the result says cancelled). Throws for a job that cannot render (bad scene, lost queue).
-  virtual RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop) = 0;
+  virtual RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop,
+                              const CheckpointPlan& checkpoint) = 0;
   // "embedded" or the queue's URL, for logs and /api/health.
   virtual std::string name() const = 0;
   // Render workers seen in the last few seconds; -1 where the backend has none (embedded).

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <regex>
 
 #include "event_stream.h"
@@ -28,13 +29,15 @@ std::shared_ptr<Job> job_or_404(JobManager& jobs, const Request& req) {
 // ---- the service ----
 
 void get_health(JobManager& jobs, const ApiOptions&, const Request&, Response& res) {
-  size_t queued = 0, running = 0;
+  size_t queued = 0, running = 0, paused = 0;
   for (auto& j : jobs.list()) {
     std::lock_guard<std::mutex> lock(j->mutex);
     queued += j->state == JobState::queued;
     running += j->state == JobState::running;
+    paused += j->state == JobState::paused;
   }
-  json health{{"status", "ok"}, {"queued", queued}, {"running", running}, {"rendering", jobs.backend_name()}};
+  json health{{"status", "ok"}, {"queued", queued}, {"running", running}, {"paused", paused}, {"rendering", jobs.backend_name()},
+              {"data_bytes", jobs.data_bytes()}};
   StreamStats st = stream_stats();
   health["stream"] = {{"watchers", st.watchers}, {"png_encodes", st.png_encodes}, {"tile_events", st.tile_events}};
   int workers = jobs.live_workers();
@@ -69,13 +72,28 @@ void submit_job(JobManager& jobs, const ApiOptions&, const Request& req, Respons
   send_json(res, created ? 201 : 200, jobs.status_json(*job));
 }
 
-void list_jobs(JobManager& jobs, const ApiOptions&, const Request&, Response& res) {
+// Newest first, a page at a time: ?limit=N (1-1000, default 100), ?cursor= the next_cursor of the
+// page before, ?state= one state only.
+void list_jobs(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  size_t limit = 100;
+  if (req.has_param("limit")) {
+    const std::string v = req.get_param_value("limit");
+    char* end = nullptr;
+    const long n = std::strtol(v.c_str(), &end, 10);
+    if (v.empty() || *end != '\0' || n < 1 || n > 1000)
+      throw HttpError(400, "query parameter 'limit' must be a whole number from 1 to 1000", "limit");
+    limit = size_t(n);
+  }
+  const std::string cursor = req.has_param("cursor") ? req.get_param_value("cursor") : "";
+  if (cursor.size() > 40 || cursor.find_first_not_of("0123456789abcdef") != std::string::npos)
+    throw HttpError(400, "query parameter 'cursor' must be a next_cursor this list gave", "cursor");
+  JobPage page = jobs.page(limit, cursor, req.has_param("state") ? req.get_param_value("state") : "");
   json list = json::array();
-  for (auto& j : jobs.list()) {
+  for (auto& j : page.jobs) {
     std::lock_guard<std::mutex> lock(j->mutex);
     list.push_back(jobs.status_json(*j, false));
   }
-  send_json(res, 200, {{"jobs", list}});
+  send_json(res, 200, {{"jobs", list}, {"next_cursor", page.next_cursor.empty() ? json(nullptr) : json(page.next_cursor)}});
 }
 
 void get_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
@@ -84,11 +102,35 @@ void get_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& 
   send_json(res, 200, jobs.status_json(*job));
 }
 
-void cancel_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
-  jobs.cancel(req.matches[1]);
+// On a finished job: deletes it and its files. On a live one: cancels it (the answer's state is
+// the state after the request).
+void delete_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  if (jobs.remove(id)) return send_json(res, 200, {{"id", id}, {"state", "deleted"}});
   auto job = job_or_404(jobs, req);
   std::lock_guard<std::mutex> lock(job->mutex);
   send_json(res, 200, jobs.status_json(*job));
+}
+
+// POST /api/jobs/{id}/pause, /resume and /continue: the job's status after the request.
+void control_job(JobManager& jobs, const Request& req, Response& res, const std::function<void(const std::string&)>& act) {
+  auto job = job_or_404(jobs, req);
+  act(job->id);
+  std::lock_guard<std::mutex> lock(job->mutex);
+  send_json(res, 200, jobs.status_json(*job));
+}
+
+void pause_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  control_job(jobs, req, res, [&](const std::string& id) { jobs.pause(id); });
+}
+
+void resume_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  control_job(jobs, req, res, [&](const std::string& id) { jobs.resume(id); });
+}
+
+void continue_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  const json body = req.body.empty() ? json::object() : parse_body(req);
+  control_job(jobs, req, res, [&](const std::string& id) { jobs.continue_job(id, body); });
 }
 
 // ---- a job's image ----
@@ -165,7 +207,10 @@ const Route kRoutes[] = {
     {"POST", "/api/jobs", submit_job},
     {"GET", "/api/jobs", list_jobs},
     {"GET", "/api/jobs/([^/]+)", get_job},
-    {"DELETE", "/api/jobs/([^/]+)", cancel_job},
+    {"DELETE", "/api/jobs/([^/]+)", delete_job},
+    {"POST", "/api/jobs/([^/]+)/pause", pause_job},
+    {"POST", "/api/jobs/([^/]+)/resume", resume_job},
+    {"POST", "/api/jobs/([^/]+)/continue", continue_job},
     {"GET", "/api/jobs/([^/]+)/image\\.(png|exr)", get_image},
     {"GET", "/api/jobs/([^/]+)/focus", get_focus},
     {"GET", "/api/jobs/([^/]+)/events", watch_job},

@@ -352,9 +352,11 @@ class EventStream:
 
 
 def health_counts(health):
-    """/api/health without its running totals ("stream"), which every request may move."""
+    """/api/health without its running totals ("stream", which every request may move, and the data
+    folder's size)."""
     assert set(health["stream"]) == {"watchers", "png_encodes", "tile_events"}, health
-    return {k: v for k, v in health.items() if k != "stream"}
+    assert isinstance(health["data_bytes"], int) and health["data_bytes"] >= 0, health
+    return {k: v for k, v in health.items() if k not in ("stream", "data_bytes")}
 
 
 # ---- raw HTTP, for requests no client library would send ----

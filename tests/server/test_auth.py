@@ -113,11 +113,11 @@ def test_token_from_the_environment(servers):
     srv = servers("env", env={"RENDER_SERVER_TOKEN": "from-env"})
     expect_401(bare(srv, "GET", "/api/jobs"), invalid=False)
     ok = requests.get(srv.url + "/api/jobs", headers={"Authorization": "Bearer from-env"}, timeout=15)
-    assert ok.status_code == 200 and ok.json() == {"jobs": []}
+    assert ok.status_code == 200 and ok.json() == {"jobs": [], "next_cursor": None}
 
 
 def test_without_a_token_nothing_is_asked(server):
-    assert server.api.get("/api/jobs").json() == {"jobs": []}
+    assert server.api.get("/api/jobs").json() == {"jobs": [], "next_cursor": None}
     assert "WWW-Authenticate" not in server.api.get("/api/jobs").headers
 
 

@@ -1,9 +1,11 @@
-"""Cancelling: a running job stops long before its sample budget and its event stream ends; a
-queued job is cancelled at once and never runs; a finished job cannot be cancelled (409). Waits
+"""Cancelling and deleting: a running job stops long before its sample budget and its event stream
+ends, and the answer says cancelled; a queued job is cancelled at once and never runs; DELETE on a
+finished job deletes it and its files. Waits
 are on states and events; their timeouts (10 s: ten times the poll interval of the job queue and
 a pass's tiles) only stop a broken server from hanging the test."""
 import time
 
+from images import decode_png
 from support import ENDLESS, TINY, health_counts
 
 
@@ -15,8 +17,8 @@ def test_cancel_stops_a_running_job(server):
     assert stream.next().kind in ("image", "status")
 
     answer = api.delete(f"/api/jobs/{job['id']}", expect=200).json()
-    assert answer["state"] in ("running", "cancelled")  # told to stop; the worker marks it
-    done = api.wait(job["id"], "cancelled", timeout=10, poll=0.01)
+    assert answer["state"] == "cancelled" and answer["eta"] is None  # the state after the request
+    done = api.job(job["id"])
     # Stopped mid-render: a tiny share of the budget done, not the render run out.
     assert done["finished_at"] is not None and done["progress"] < 0.5, done
 
@@ -29,11 +31,16 @@ def test_cancel_stops_a_running_job(server):
     samples = api.job(job["id"])["samples"]
     time.sleep(0.2)
     assert api.job(job["id"])["samples"] == samples
-    assert health_counts(api.get("/api/health").json()) == {"status": "ok", "queued": 0, "running": 0, "rendering": "embedded"}
+    assert health_counts(api.get("/api/health").json()) == {"status": "ok", "queued": 0, "running": 0, "paused": 0, "rendering": "embedded"}
 
-    # Cancelling again is a conflict.
-    err = api.error(api.delete(f"/api/jobs/{job['id']}"), 409)
-    assert "cancelled" in err["message"]
+    # What it had rendered can be downloaded, as from its viewer.
+    _, _, pixels = decode_png(api.get(f"/api/jobs/{job['id']}/image.png").content)
+    assert any(pixels), "the cancelled job's image is black"
+    assert (server.data / "jobs" / job["id"] / "image.exr").is_file()
+
+    # Deleting it now deletes it.
+    assert api.delete(f"/api/jobs/{job['id']}", expect=200).json() == {"id": job["id"], "state": "deleted"}
+    api.error(api.get(f"/api/jobs/{job['id']}", expect=None), 404)
 
 
 def test_cancel_queued_job(server):
@@ -64,8 +71,13 @@ def test_delete_finished_or_unknown_job(server):
     api = server.api
     job = api.submit(TINY)
     api.wait(job["id"], "done", timeout=20)
-    err = api.error(api.delete(f"/api/jobs/{job['id']}"), 409)
-    assert "done" in err["message"]
-    assert api.job(job["id"])["state"] == "done"  # unchanged
+    folder = server.data / "jobs" / job["id"]
+    assert (folder / "image.png").is_file()
+    assert api.delete(f"/api/jobs/{job['id']}", expect=200).json() == {"id": job["id"], "state": "deleted"}
+    assert not folder.exists(), "its files stayed"
+    api.error(api.get(f"/api/jobs/{job['id']}", expect=None), 404)
+    api.error(api.get(f"/api/jobs/{job['id']}/image.png", expect=None), 404)
+    assert job["id"] not in [j["id"] for j in api.get("/api/jobs").json()["jobs"]]
+    api.error(api.delete(f"/api/jobs/{job['id']}"), 404)  # gone
     api.error(api.delete("/api/jobs/0123456789abcdef"), 404)
     api.error(api.delete("/api/jobs/not-a-job"), 404)

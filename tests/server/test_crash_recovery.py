@@ -130,10 +130,10 @@ def test_what_a_crash_can_leave_is_cleaned_up_at_start(servers):
     (jobs / "0000000000000000").mkdir()
     (jobs / b["id"] / "image.png").write_bytes(b"")
     srv = servers("planted", threads=2)
-    assert sorted(p.name for p in (jobs / a["id"]).iterdir()) == ["image.exr", "image.png", "job.json"]
+    assert sorted(p.name for p in (jobs / a["id"]).iterdir()) == ["checkpoint.bin", "image.exr", "image.png", "job.json"]
     assert not (jobs / "0000000000000000").exists()
     assert "removed 2 temp files" in srv.log_text()
-    assert [j["id"] for j in srv.api.get("/api/jobs").json()["jobs"]] == [a["id"], b["id"]]
+    assert [j["id"] for j in srv.api.get("/api/jobs").json()["jobs"]] == [b["id"], a["id"]]  # newest first
     assert srv.api.job(a["id"])["state"] == "done"
     redone = srv.api.wait(b["id"], "done", timeout=30)  # its empty image: rendered again
     assert redone["started_at"] > b["created_at"]

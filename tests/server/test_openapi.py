@@ -82,8 +82,8 @@ def test_read_only_answers_match(servers, tmp_path):
     assert scenes["cornell"]["summary"]["spheres"] == 2 and "area" in scenes["cornell"]["summary"]["lights"]
     if course.exists():
         assert scenes["CBspheres_lambertian"]["summary"]["spheres"] == 2
-    assert health_counts(srv.api.get("/api/health").json()) == {"status": "ok", "queued": 0, "running": 0, "rendering": "embedded"}
-    assert srv.api.get("/api/jobs").json() == {"jobs": []}
+    assert health_counts(srv.api.get("/api/health").json()) == {"status": "ok", "queued": 0, "running": 0, "paused": 0, "rendering": "embedded"}
+    assert srv.api.get("/api/jobs").json() == {"jobs": [], "next_cursor": None}
     job = srv.api.submit(TINY)
     assert job["url"] == f"/api/jobs/{job['id']}" and job["events"] == f"/api/jobs/{job['id']}/events"
     srv.api.wait(job["id"], "done", timeout=20)

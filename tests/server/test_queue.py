@@ -22,7 +22,7 @@ def test_queue_full_is_429_with_retry_after(servers):
     err = api.error(refused, 429)
     assert "queue is full" in err["message"]
     assert int(refused.headers["Retry-After"]) >= 1
-    assert health_counts(api.get("/api/health").json()) == {"status": "ok", "queued": 1, "running": 1, "rendering": "embedded"}
+    assert health_counts(api.get("/api/health").json()) == {"status": "ok", "queued": 1, "running": 1, "paused": 0, "rendering": "embedded"}
     assert len(api.get("/api/jobs").json()["jobs"]) == 2  # the refused job left no trace
 
     # A repeated Idempotency-Key is answered even when the queue is full: nothing new is queued.

@@ -47,7 +47,7 @@ def test_kill_9_then_restart_recovers(servers):
     srv2 = servers("node")  # same data directory, new process, new port
     api = srv2.api
     jobs = {j["id"]: j for j in api.get("/api/jobs").json()["jobs"]}
-    assert list(jobs)[0] == a["id"] and list(jobs)[-1] == b["id"]  # oldest first
+    assert list(jobs)[0] == b["id"] and list(jobs)[-1] == a["id"]  # newest first
     assert jobs[a["id"]]["state"] == "done"
     assert jobs[b["id"]]["state"] in ("queued", "running")
     b_done = api.wait(b["id"], "done", timeout=60)
@@ -67,7 +67,8 @@ def test_kill_9_then_restart_recovers(servers):
     events = srv2.events(a["id"]).until_end()
     assert [e.kind for e in events] == ["image", "status", "end"]
     assert base64.b64decode(events[0].data["png"]) == a_png
-    api.delete(f"/api/jobs/{a['id']}", expect=409)
+    assert api.delete(f"/api/jobs/{a['id']}", expect=200).json() == {"id": a["id"], "state": "deleted"}
+    assert not (srv2.data / "jobs" / a["id"]).exists()
 
 
 def test_sigterm_stops_cleanly_and_requeues(servers):
