@@ -57,6 +57,9 @@ class EmbeddedBackend : public RenderBackend {
       return RenderReport{session->progress(), st.samples, st.rays, st.nonfinite, error};
     };
     if (resumed) {  // the checkpoint's picture and counts, before the first new pass
+      std::fprintf(stderr, "render-server: job %s: resuming from its checkpoint (%.1f spp a pixel, %.2f s rendered)\n",
+                   job.id.c_str(), double(session->stats().samples) / double(session->film().pixels()),
+                   session->seconds());
       for (const pt::Tile& t : session->tiles()) on_tile(t);
       sink.pass(report(session->error_estimate()));
     }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "driver.h"
@@ -133,7 +134,9 @@ void JobManager::continue_job(const std::string& id, const json& body) {
   const bool budget_spent = job->state == JobState::done && job->stopped == pt::stop_reason_name(pt::StopReason::finished);
   if (body.contains("spp")) spec["spp"] = body["spp"];
   else if (budget_spent && (body.contains("target_error") || body.contains("time_limit")))
-    spec["spp"] = m_config.limits.max_spp;  // the target or the limit decides how far it goes
+    // The target or the limit decides how far it goes, up to the server's largest budget.
+    spec["spp"] = int(std::min<double>(m_config.limits.max_spp, std::floor(m_config.limits.max_pixel_samples /
+                  (double(job->spec.params.width) * job->spec.params.height))));
   // A limit that ended the render would end it again at once: it goes unless given anew.
   if (body.contains("target_error")) spec["target_error"] = body["target_error"];
   else if (job->stopped == pt::stop_reason_name(pt::StopReason::target_error)) spec["target_error"] = 0;
@@ -216,7 +219,9 @@ void JobManager::enforce_retention() {
       if (is_final(kv.second->state)) finished.push_back({kv.first, bytes});
     }
   }
-  size_t excess = m_config.keep_jobs && finished.size() > m_config.keep_jobs ? finished.size() - m_config.keep_jobs : 0;
+  // The newest finished job stays whatever its size: it is the image someone is waiting for.
+  if (!finished.empty()) finished.pop_back();
+  size_t excess = m_config.keep_jobs && finished.size() + 1 > m_config.keep_jobs ? finished.size() + 1 - m_config.keep_jobs : 0;
   for (const auto& [id, bytes] : finished) {
     const bool over = m_config.max_data_bytes && total > m_config.max_data_bytes;
     if (excess == 0 && !over) break;

@@ -34,8 +34,9 @@ class JobStateSink : public JobSink {
       j.linear.assign(n * 3, 0.0f);
       j.display.assign(n * 3, 0);
       j.region_version.assign(size_t(j.regions_x) * j.regions_y, 0);
-      // A resumed render keeps its history up to the checkpoint; its first pass() brings the counts.
-      j.samples = 0;
+      // A resumed render keeps its history up to the checkpoint, and its counts (its first pass()
+      // brings the checkpoint's): spp_done never drops to 0 on the way.
+      if (resumed_seconds <= 0) j.samples = 0;
       while (!j.history.empty() && !(j.history.back().seconds <= resumed_seconds)) j.history.pop_back();
       j.has_image = false;
       j.features = features;
