@@ -183,9 +183,8 @@ void Film::save(BinaryWriter& out) const {
 void Film::restore(BinaryReader& in) {
   const int32_t w = in.pod<int32_t>(), h = in.pod<int32_t>(), spp = in.pod<int32_t>();
   const bool caustics = in.pod<uint8_t>() != 0;
-  if (w != m_w || h != m_h || caustics != has_caustics())
-    in.fail("a " + std::to_string(w) + "x" + std::to_string(h) + " film" + (caustics ? " with" : " without") +
-            " light-traced caustics");
+  // Splat sums come with the film: a merged film gains them with its first pass that has some.
+  if (w != m_w || h != m_h) in.fail("a " + std::to_string(w) + "x" + std::to_string(h) + " film");
   if (spp < 1 || spp > m_spp)
     in.fail("a film of " + std::to_string(spp) + " spp, more than this render's " + std::to_string(m_spp) +
             " (a budget can grow, not shrink)");

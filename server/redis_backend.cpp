@@ -9,7 +9,9 @@
 #include <random>
 #include <set>
 
+#include "checkpoint.h"
 #include "collada.h"
+#include "job_store.h"
 #include "film_pass.h"
 #include "jobs.h"
 #include "redis_queue.h"
@@ -79,6 +81,23 @@ class PassPlan {
     return m_ranges.back();
   }
 
+  // Checkpoints: the ranges issued so far and the measured rate.
+  void save(pt::BinaryWriter& out) const {
+    out.pod(m_next_first), out.pod(m_rate), out.pod(uint64_t(m_ranges.size()));
+    for (auto [first, count] : m_ranges) out.pod(first), out.pod(count);
+  }
+  void restore(pt::BinaryReader& in) {
+    m_next_first = in.pod<uint32_t>(), m_rate = in.pod<double>();
+    const uint64_t n = in.pod<uint64_t>();
+    if (n > m_spp || m_next_first > m_spp || !(m_rate >= 0 && m_rate < 1e15)) in.fail("an impossible pass plan");
+    m_ranges.clear();
+    for (uint64_t k = 0; k < n; ++k) {
+      const uint32_t first = in.pod<uint32_t>(), count = in.pod<uint32_t>();
+      if (count == 0 || first >= m_next_first || count > m_next_first - first) in.fail("an impossible pass");
+      m_ranges.push_back({first, count});
+    }
+  }
+
  private:
   uint32_t m_spp, m_next_first = 0;
   size_t m_pixels;
@@ -134,13 +153,25 @@ class WorkerPasses : public pt::PassSource {
   bool advance(int, const std::atomic<bool>* cancel, const pt::TileCallback& on_tile) override;
   void set_deadline(std::chrono::steady_clock::time_point t) override { m_deadline = t; }
   const pt::Film& film() const override { return m_film; }
-  double seconds() const override { return std::chrono::duration<double>(clock::now() - m_t0).count(); }
+  double seconds() const override { return m_seconds_before + std::chrono::duration<double>(clock::now() - m_t0).count(); }
   bool finished() const override {
     return m_film.finished() || (m_plan.exhausted() && m_merged.size() == m_plan.issued());
   }
   RenderReport report(double error) const { return {m_film.progress(), m_samples, m_rays, m_nonfinite, error}; }
   // After the last advance: the sink has started, and the log has the job's merge costs.
   void finish(pt::StopReason why);
+  // Checkpoints: the merged film, the passes issued and which of them were merged. A restored run
+  // (a new run id) issues again the passes that were out when the server stopped.
+  void save(pt::BinaryWriter& out) const;
+  void restore(pt::BinaryReader& in);
+  void reset();  // back to no pass, after a restore that failed part way
+  // After a restore: the sink starts with the checkpoint's time and the job's features.
+  void resumed(const std::vector<std::string>& features) {
+    m_sink.started(m_w, m_h, features, m_seconds_before);
+    m_started = true;
+  }
+  bool started() const { return m_started; }
+  const std::vector<pt::Tile>& tiles() const { return m_tiles; }
 
  private:
   using clock = std::chrono::steady_clock;
@@ -170,7 +201,40 @@ class WorkerPasses : public pt::PassSource {
   double m_merge_seconds = 0;  // decoding, merging and publishing passes: the server's cost per pass
   size_t m_pass_bytes = 0;
   uint64_t m_samples = 0, m_rays = 0, m_nonfinite = 0;
+  double m_seconds_before = 0;  // rendering time a checkpoint restored
 };
+
+void WorkerPasses::save(pt::BinaryWriter& out) const {
+  m_plan.save(out);
+  out.pod(uint64_t(m_merged.size()));
+  for (uint32_t u : m_merged) out.pod(u);
+  out.pod(m_samples), out.pod(m_rays), out.pod(m_nonfinite), out.pod(seconds());
+  m_film.save(out);
+}
+
+void WorkerPasses::reset() {
+  m_plan = PassPlan(m_params.spp, size_t(m_w) * m_h, m_params.caustic_tracing ? 32.0 : 20.0);
+  m_film = pt::Film(m_w, m_h, m_params.spp, pt::adaptive_rule(m_params), false);
+  m_merged.clear();
+  m_samples = m_rays = m_nonfinite = 0;
+  m_seconds_before = 0;
+}
+
+void WorkerPasses::restore(pt::BinaryReader& in) {
+  m_plan.restore(in);
+  const uint64_t n = in.pod<uint64_t>();
+  if (n > m_plan.issued()) in.fail("more passes merged than issued");
+  for (uint64_t k = 0; k < n; ++k) {
+    const uint32_t u = in.pod<uint32_t>();
+    if (u >= m_plan.issued()) in.fail("a pass never issued");
+    m_merged.insert(u);
+  }
+  m_samples = in.pod<uint64_t>(), m_rays = in.pod<uint64_t>(), m_nonfinite = in.pod<uint64_t>();
+  m_seconds_before = in.pod<double>();
+  if (!(m_seconds_before >= 0 && m_seconds_before < 1e12)) in.fail("an impossible render time");
+  m_film.restore(in);
+  m_t0 = clock::now();
+}
 
 void WorkerPasses::issue(size_t unit) {
   auto [first, count] = m_plan.range(unit);
@@ -294,7 +358,7 @@ class RedisBackend : public RenderBackend {
     }
   }
 
-  RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop, const CheckpointPlan&) override {
+  RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop, const CheckpointPlan& plan) override {
     const JobSpec& spec = job.spec;
     std::string path = m_scenes.resolve(spec.scene), scene_text;
     if (path.empty() || !read_file(path, scene_text)) throw std::runtime_error("scene '" + spec.scene + "' is gone");
@@ -304,19 +368,54 @@ class RedisBackend : public RenderBackend {
     RedisClient redis(m_address, 5.0, false);
     redis.set_patience(m_redis_timeout, &stop, "render-server: job " + job.id);
     WorkerPasses passes(job, scene_text, redis, sink, [this] { return live_workers(); }, m_in_flight);
-    RenderResult result;
+    const std::string fingerprint = pt::render_fingerprint(scene_text, spec.params);
     auto on_tile = [&](const pt::Tile& t) {
       thread_local std::vector<pt::Vec3> buf;
       passes.film().read_tile(t, buf);
       sink.tile(t, buf);
     };
-    auto on_pass = [&](const pt::PassReport& r) { sink.pass(passes.report(r.error)); };
+    if (!plan.path.empty() && restore(plan.path, fingerprint, job, passes)) {
+      std::vector<std::string> features;
+      {
+        std::lock_guard<std::mutex> lock(job.mutex);
+        features = job.features;
+      }
+      passes.resumed(features);
+      for (const pt::Tile& t : passes.tiles()) on_tile(t);
+      sink.pass(passes.report(passes.error_estimate()));
+    }
+    RenderResult result;
+    auto last_save = std::chrono::steady_clock::now();
+    auto save = [&](bool force) {
+      const auto now = std::chrono::steady_clock::now();
+      if (plan.path.empty() || !passes.started() ||
+          (!force && std::chrono::duration<double>(now - last_save).count() < plan.interval))
+        return;
+      last_save = now;
+      try {
+        pt::BinaryWriter out;
+        out.text(kCheckpointMagic), out.text(fingerprint);
+        passes.save(out);
+        write_file_atomic(plan.path, out.bytes());
+        sink.checkpointed(passes.report(INFINITY).samples, passes.seconds());
+      } catch (const std::exception& e) {  // costs the resume, not the render
+        std::fprintf(stderr, "render-server: job %s: %s\n", job.id.c_str(), e.what());
+      }
+    };
+    pt::ProgressiveDriver driver(passes, {spec.time_limit, spec.target_error});
     try {
-      result.why = pt::run_progressive(passes, {spec.time_limit, spec.target_error}, &stop, on_tile, on_pass);
+      while (!driver.done()) {
+        const pt::PassReport r = driver.step(&stop, on_tile);
+        sink.pass(passes.report(r.error));
+        if (!r.completed) break;
+        save(false);
+      }
+      result.why = driver.done() ? driver.reason() : pt::StopReason::cancelled;
     } catch (const RedisUnreachable&) {
       if (!stop) throw;  // away past --redis-timeout: the job fails, saying so
       result.why = pt::StopReason::cancelled;  // cancelled (or the server stopping) while waiting
     }
+    save(true);  // a pause, a restart or a continue takes the merged film from here
     passes.finish(result.why);
     result.image = passes.film().image();
     result.report = passes.report(passes.error_estimate());
@@ -325,6 +424,30 @@ class RedisBackend : public RenderBackend {
   }
 
  private:
+  static constexpr const char* kCheckpointMagic = "render-server merged film 1";
+
+  // The job's checkpoint into `passes`: false when there is none, or it is another render's or
+  // damaged (said in the log; the job renders from the start).
+  static bool restore(const std::string& path, const std::string& fingerprint, const Job& job, WorkerPasses& passes) {
+    std::string bytes;
+    if (!read_file(path, bytes)) return false;
+    try {
+      pt::BinaryReader in(bytes, path);
+      if (in.text(64) != kCheckpointMagic) in.fail("not a merged film");
+      if (in.text(1 << 16) != fingerprint) in.fail("a checkpoint of another render");
+      passes.restore(in);
+      if (!in.at_end()) in.fail("bytes past the end");
+      std::fprintf(stderr, "render-server: job %s: resuming from its checkpoint (%.1f spp a pixel, %.2f s rendered)\n",
+                   job.id.c_str(), double(passes.report(INFINITY).samples) / double(passes.film().pixels()),
+                   passes.seconds());
+      return true;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "render-server: job %s: %s; rendering from the start\n", job.id.c_str(), e.what());
+      passes.reset();
+      return false;
+    }
+  }
+
   SceneLibrary& m_scenes;
   RedisAddress m_address;
   int m_in_flight;

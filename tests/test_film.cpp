@@ -194,7 +194,7 @@ namespace pt {
 namespace {
 
 // A film saved and restored (checkpoints) holds the same statistics: the same image, mask and
-// error estimate; a film of another size or a cut record is refused.
+// error estimate; a film of another size or a smaller budget, or a cut record, is refused.
 TEST(Film, SaveAndRestoreKeepEveryStatistic) {
   Fixture f(64, true);
   RenderSession session(*f.scene, f.params);
@@ -212,9 +212,22 @@ TEST(Film, SaveAndRestoreKeepEveryStatistic) {
   EXPECT_EQ(back.done_mask(), film.done_mask());
   EXPECT_EQ(back.light_paths(), film.light_paths());
   EXPECT_EQ(back.error_estimate(), film.error_estimate());
-  Film other(48, 36, 128, adaptive_rule(f.params), true);
-  BinaryReader again(out.bytes(), "film.bin");
-  EXPECT_THROW(other.restore(again), std::runtime_error);
+  for (auto [w, spp] : {std::pair{48, 32}, std::pair{64, 64}}) {  // a smaller budget, another size
+    Film other(w, 36, spp, adaptive_rule(f.params), true);
+    BinaryReader again(out.bytes(), "film.bin");
+    EXPECT_THROW(other.restore(again), std::runtime_error) << w << " " << spp;
+  }
+  // A larger budget takes the film on: its budget-stopped pixels reopen; a merged film (made
+  // without splat sums) gains the saved ones.
+  Film larger(48, 36, 128, adaptive_rule(f.params), false);
+  BinaryReader more(out.bytes(), "film.bin");
+  larger.restore(more);
+  EXPECT_TRUE(larger.has_caustics());
+  EXPECT_EQ(larger.light_paths(), film.light_paths());
+  EXPECT_TRUE(film.finished());
+  EXPECT_FALSE(larger.finished());
+  const ImageRGB c = larger.image();
+  EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(Vec3)), 0);
   const std::string cut = out.bytes().substr(0, out.bytes().size() - 9);
   BinaryReader short_in(cut, "film.bin");
   try {

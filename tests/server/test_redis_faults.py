@@ -9,10 +9,13 @@ redis-server, render-server --queue and render-worker processes:
 - Redis killed mid-job and started again empty on the same port: the server and the workers
   reconnect, the server puts the run back (group, scene, hash, unmerged passes) and the job finishes
   with every sample and the single-process image;
+- the server killed mid-job and started again: the job resumes from its merged film's checkpoint
+  and still ends with every sample once and the single-process image;
 - Redis gone for good: the job fails after --redis-timeout naming Redis, the server stays up, and a
   worker gives up after its own --redis-timeout."""
 import json
 import re
+import signal
 import socket
 
 import pytest
@@ -187,6 +190,33 @@ def test_a_redis_restart_mid_job_loses_nothing(cluster, servers):
     # Later jobs render on the new Redis as usual.
     later = srv.api.submit(dict(SMALL, seed=2))["id"]
     assert srv.api.wait(later, FINAL, timeout=60)["state"] == "done"
+
+
+def test_a_server_killed_mid_job_resumes_its_merged_film(cluster, servers):
+    args = ["--queue", None, "--units-in-flight", "4", "--checkpoint-interval", "0"]
+    srv, workers, redis = cluster(workers=2, server_args=args[4:])
+    job_id = srv.api.submit(JOB)["id"]
+    job_json = srv.data / "jobs" / job_id / "job.json"
+    wait_for(lambda: json.loads(job_json.read_text())["checkpoint"]["samples"] > 0, "a first checkpoint", 60)
+    srv.proc.send_signal(signal.SIGSTOP)
+    on_disk = json.loads(job_json.read_text())
+    assert on_disk["state"] == "running", "the job ended before the kill: nothing is tested"
+    srv.kill()
+
+    args[1] = redis.url
+    srv = servers("scaled", threads=1, args=args)
+    assert srv.api.job(job_id)["samples"] >= on_disk["checkpoint"]["samples"] > 0, "spp_done started again from 0"
+    done = srv.api.wait(job_id, FINAL, timeout=180)
+    assert done["state"] == "done", done
+    assert "resuming from its checkpoint" in srv.log_text()
+    assert done["samples"] == JOB["width"] * JOB["height"] * JOB["spp"], "every sample merged exactly once"
+    single = servers("single", threads=2)
+    ref_id = single.api.submit(JOB)["id"]
+    assert single.api.wait(ref_id, FINAL, timeout=180)["state"] == "done"
+    _, _, dist, _ = image(srv.api, job_id)
+    _, _, ref, _ = image(single.api, ref_id)
+    worst = max(abs(a - b) / (abs(b) + 1e-3) for c in "RGB" for a, b in zip(dist[c], ref[c]))
+    assert worst < 1e-3, f"the resumed image differs by up to {worst:.2e} (relative)"
 
 
 def test_redis_gone_for_good_fails_the_job_after_redis_timeout(cluster):
