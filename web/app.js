@@ -1,14 +1,15 @@
 // The render-job page: a form that validates against /api/jobs/check, a viewer fed by the job's
-// event stream (tiles paint as they arrive), click-to-focus, the job list, and the wiring. No
-// framework, no build step: common.js (state, API), feed.js (a job's event stream), chart.js and
-// sweep.js load before this file (index.html), as plain scripts sharing their top-level names.
+// event stream (tiles paint as they arrive), click-to-focus, and the wiring. No framework, no
+// build step: common.js (state, API), feed.js (a job's event stream), chart.js, sweep.js and
+// jobs.js (the job list) load before this file (index.html), as plain scripts sharing their
+// top-level names.
 'use strict';
 
 // Form fields: name -> kind. The input of field F is #f-F and its error line is #err-F.
 const FIELDS = {
   scene: 'select', max_depth: 'int', light_samples: 'int', aperture: 'num', focal_distance: 'num',
   spp: 'int', width: 'int', height: 'int', seed: 'int', time_limit: 'num', target_error: 'num', adaptive: 'bool',
-  keep_fov: 'bool', caustic_tracing: 'bool',
+  adaptive_tolerance: 'num', keep_fov: 'bool', caustic_tracing: 'bool',
 };
 
 // ---------- the main viewer ----------
@@ -16,12 +17,21 @@ const FIELDS = {
 const viewer = {
   feed: null,
   id: null,
+  fillPending: false,  // the form takes the job's settings when its status arrives
+  moreFor: null,       // the job whose spp the "Render more" field was set for
 
-  show(id) {
-    if (this.id === id) return;
+  // Opens a job; with fill, its settings go into the form (a reload, a link, the list's Open), so
+  // that click-to-focus and the sweeps start from the image on screen.
+  show(id, { fill = false } = {}) {
+    if (this.id === id) {
+      if (fill && this.feed && this.feed.status) fillForm(this.feed.status.spec);
+      return;
+    }
     if (this.feed) this.feed.detach(this);
     this.id = id;
     this.feed = null;
+    this.fillPending = fill;
+    this.moreFor = null;
     $('#v-marker').hidden = true;
     this.note('');
     history.replaceState(null, '', id ? `#job=${id}` : '#');
@@ -34,14 +44,19 @@ const viewer = {
     $('#v-progress-text').textContent = '';
     for (const k of ['#v-spp', '#v-elapsed', '#v-eta', '#v-error']) $(k).textContent = '–';
     $('#v-cancel').disabled = true;
+    $('#v-pause').hidden = true;
     $('#v-edit').disabled = true;
+    $('#v-more-form').hidden = true;
     setLink($('#v-png'), null);
     setLink($('#v-exr'), null);
     drawChart($('#v-chart'), []);
     const c = $('#v-canvas');
     clearCanvas(c, c.width, c.height);
     highlightRow();
-    if (!id) return;
+    if (!id) {
+      $('#v-title').textContent = 'No job open';
+      return;
+    }
     $('#v-title').textContent = `Job ${shortId(id)}`;
     $('#v-placeholder').textContent = 'Waiting for the first tiles…';
     $('#v-placeholder').hidden = false;
@@ -64,6 +79,8 @@ const viewer = {
       $('#viewer').dataset.conn = feed.conn;
     } else if (type === 'history') {
       drawChart($('#v-chart'), feed.history);
+    } else if (type === 'reopen') {
+      $('#viewer').dataset.ended = 'false';
     } else if (type === 'end') {
       $('#viewer').dataset.ended = 'true';
       const st = feed.status && feed.status.state;
@@ -73,6 +90,11 @@ const viewer = {
       }
     } else if (type === 'gone') {
       $('#v-state').hidden = true;
+      $('#v-cancel').disabled = true;
+      $('#v-pause').hidden = true;
+      $('#v-more-form').hidden = true;
+      setLink($('#v-png'), null);
+      setLink($('#v-exr'), null);
       $('#v-placeholder').hidden = false;
       $('#v-placeholder').textContent = 'This job no longer exists on the server.';
       $('#viewer').dataset.state = 'gone';
@@ -96,18 +118,43 @@ const viewer = {
     let text = `${pct.toFixed(pct < 10 && pct > 0 ? 1 : 0)}%`;
     if (s.state === 'running' && s.eta !== null && s.eta !== undefined) text += ` · ETA ${fmtDuration(s.eta)}`;
     if (s.state === 'queued') text = 'queued';
+    if (s.state === 'paused') text = `paused · ${text}`;
+    if (s.state === 'done' && s.stopped && s.stopped !== 'finished') text += ` · ${s.stopped}`;
     if (s.state === 'failed') text = `failed${s.message ? `: ${s.message}` : ''}`;
     $('#v-progress-text').textContent = text;
     $('#v-spp').textContent = `${fmtNum(s.spp_done, 3)} / ${spec.spp}`;
     $('#v-spp').title = `${Number(s.samples || 0).toLocaleString()} samples taken`;
     $('#v-elapsed').textContent = fmtDuration(s.elapsed);
-    $('#v-eta').textContent = s.state === 'running' ? fmtDuration(s.eta) : FINAL.has(s.state) ? '–' : '…';
+    $('#v-eta').textContent = s.state === 'running' ? fmtDuration(s.eta) : s.state === 'queued' ? '…' : '–';
     $('#v-error').textContent = fmtNum(s.error_estimate, 3);
     $('#v-cancel').disabled = FINAL.has(s.state);
+    const pause = $('#v-pause');
+    pause.hidden = FINAL.has(s.state);
+    pause.textContent = s.state === 'paused' ? 'Resume' : 'Pause';
+    pause.dataset.action = s.state === 'paused' ? 'resume' : 'pause';
     $('#v-edit').disabled = false;
+    this.renderMore(s);
+    if (this.fillPending && s.spec) {
+      this.fillPending = false;
+      fillForm(s.spec);
+    }
     const hasImage = s.state === 'done' || (this.feed && this.feed.painted);
     setLink($('#v-png'), hasImage ? s.images.png : null, `render-${s.id}.png`);
     setLink($('#v-exr'), hasImage ? s.images.exr : null, `render-${s.id}.exr`);
+  },
+
+  // "Render more": a finished job whose film is kept continues, to its own spp when it stopped
+  // short of it (cancelled, a target or a time limit reached), else to twice that, to start.
+  renderMore(s) {
+    const form = $('#v-more-form');
+    form.hidden = !(s.can_continue && FINAL.has(s.state));
+    if (form.hidden) return;
+    const key = `${s.id}:${s.spec.spp}`;
+    if (this.moreFor === key) return;  // keep what the user typed
+    this.moreFor = key;
+    const spent = s.state === 'done' && s.stopped === 'finished';
+    $('#v-more-spp').value = String(spent ? s.spec.spp * 2 : s.spec.spp);
+    $('#v-more-spp').min = String(s.spec.spp);
   },
 
   note(text, kind = '') {
@@ -348,112 +395,6 @@ async function loadScenes() {
   return true;
 }
 
-// ---------- the job list ----------
-
-const rows = new Map();  // id -> <tr>
-
-function rowFor(id) {
-  let tr = rows.get(id);
-  if (tr) return tr;
-  tr = document.createElement('tr');
-  tr.dataset.id = id;
-  tr.innerHTML = '<td class="mono id-col"></td><td class="scene"></td><td class="opt size"></td><td class="opt spp"></td>' +
-    '<td><span class="badge"></span><div class="progress mini"><div class="bar"></div></div></td>' +
-    '<td class="row-actions"><button type="button" data-action="open">Open</button>' +
-    '<button type="button" data-action="cancel" class="danger">Cancel</button>' +
-    '<a class="button" data-action="png">PNG</a><a class="button" data-action="exr">EXR</a></td>';
-  rows.set(id, tr);
-  return tr;
-}
-
-function renderJobs(jobs) {
-  jobs.sort((a, b) => (a.id < b.id ? 1 : -1));  // ids sort by creation time: newest first
-  const body = $('#job-rows');
-  const seen = new Set();
-  jobs.forEach((j, i) => {
-    seen.add(j.id);
-    const tr = rowFor(j.id);
-    const spec = j.spec || {};
-    tr.dataset.state = j.state;
-    tr.cells[0].textContent = shortId(j.id);
-    tr.cells[0].title = j.id;
-    tr.cells[1].textContent = spec.scene || '';
-    tr.cells[2].textContent = `${j.width}×${j.height}`;
-    tr.cells[3].textContent = String(spec.spp);
-    const badge = tr.querySelector('.badge');
-    badge.textContent = j.state === 'running' ? `running ${Math.round(j.progress * 100)}%` : j.state;
-    badge.dataset.state = j.state;
-    tr.querySelector('.bar').style.width = `${Math.round((j.progress || 0) * 100)}%`;
-    tr.querySelector('[data-action=cancel]').hidden = FINAL.has(j.state);
-    setLink(tr.querySelector('[data-action=png]'), j.state === 'done' ? j.images.png : null, `render-${j.id}.png`);
-    setLink(tr.querySelector('[data-action=exr]'), j.state === 'done' ? j.images.exr : null, `render-${j.id}.exr`);
-    if (body.children[i] !== tr) body.insertBefore(tr, body.children[i] || null);
-  });
-  for (const [id, tr] of rows) {
-    if (!seen.has(id)) { tr.remove(); rows.delete(id); }
-  }
-  $('#jobs-empty').hidden = jobs.length > 0;
-  highlightRow();
-}
-
-function highlightRow() {
-  for (const [id, tr] of rows) tr.classList.toggle('current', id === viewer.id);
-}
-
-async function cancelJob(id) {
-  const r = await api(`/api/jobs/${id}`, { method: 'DELETE' });
-  if (!r || !r.ok) {
-    const e = apiError(r);
-    if (viewer.id === id) viewer.note(`Cannot cancel: ${e.message}`, 'error');
-    else alert(`Cannot cancel job ${shortId(id)}: ${e.message}`);
-  }
-  refreshJobs();
-  refreshJobsSoon(400);
-}
-
-let pollTimer = null;
-function schedulePoll(ms = POLL_MS) {
-  clearTimeout(pollTimer);
-  pollTimer = setTimeout(refreshJobs, ms);
-}
-
-let soonTimer = null;
-function refreshJobsSoon(ms = 150) {
-  clearTimeout(soonTimer);
-  soonTimer = setTimeout(refreshJobs, ms);
-}
-
-let refreshing = null;
-async function refreshJobs() {
-  if (refreshing) return refreshing;
-  refreshing = (async () => {
-    const r = await api('/api/jobs');
-    if (!r || !r.ok) {
-      connectionLost();
-      return;
-    }
-    const wasDown = state.pollOk === false;
-    state.pollOk = true;
-    renderJobs(r.data.jobs || []);
-    if (wasDown) onReconnected();
-    updateConn();
-    schedulePoll();
-  })();
-  try { await refreshing; } finally { refreshing = null; }
-}
-
-// The server is back: reload what may have changed, and restart the streams that gave up.
-function onReconnected() {
-  if (!state.scenes.length) loadScenes();
-  for (const f of state.feeds.values()) {
-    if (f.gone || f.ended) continue;
-    if (!f.es || f.es.readyState === EventSource.CLOSED) {
-      f.es = null;
-      f.start();
-    }
-  }
-}
-
 // ---------- wiring ----------
 
 function init() {
@@ -476,20 +417,22 @@ function init() {
   $('#aperture-sweep').addEventListener('click', () => runSweep('aperture'));
   $('#sweep-close').addEventListener('click', closeSweep);
   $('#v-canvas').addEventListener('click', focusAt);
-  $('#v-cancel').addEventListener('click', () => viewer.id && cancelJob(viewer.id));
+  $('#v-cancel').addEventListener('click', () => viewer.id && jobAction(viewer.id, 'cancel'));
+  $('#v-pause').addEventListener('click', (e) => viewer.id && jobAction(viewer.id, e.currentTarget.dataset.action));
+  $('#v-more-form').addEventListener('submit', async (e) => {
+    e.preventDefault();
+    const id = viewer.id, spp = Number($('#v-more-spp').value);
+    if (!id) return;
+    if (!(Number.isInteger(spp) && spp > 0)) return viewer.note('Render more: enter a whole number of samples per pixel.', 'error');
+    if (await jobAction(id, 'continue', { spp })) viewer.note(`Rendering on to ${spp} spp.`, 'ok');
+  });
   $('#v-edit').addEventListener('click', () => {
     if (viewer.feed && viewer.feed.status) {
       fillForm(viewer.feed.status.spec);
       viewer.note('The form now holds this job\'s settings.', 'ok');
     }
   });
-  $('#job-rows').addEventListener('click', (e) => {
-    const b = e.target.closest('[data-action]');
-    if (!b) return;
-    const id = b.closest('tr').dataset.id;
-    if (b.dataset.action === 'open') viewer.show(id);
-    else if (b.dataset.action === 'cancel') cancelJob(id);
-  });
+  initJobs();
   let resizeTimer = null;
   window.addEventListener('resize', () => {
     clearTimeout(resizeTimer);
@@ -500,7 +443,7 @@ function init() {
   });
   window.addEventListener('hashchange', () => {
     const m = location.hash.match(/job=([0-9a-f]+)/);
-    if (m) viewer.show(m[1]);
+    if (m) viewer.show(m[1], { fill: true });
   });
   drawChart($('#v-chart'), []);
   fitStage();
@@ -516,12 +459,12 @@ async function start() {
   }
   await refreshJobs();
   const m = location.hash.match(/job=([0-9a-f]+)/);
-  if (m) viewer.show(m[1]);
+  if (m) viewer.show(m[1], { fill: true });
   else {
     // Show what is rendering now, else the newest job.
-    const list = [...rows.values()].map((tr) => ({ id: tr.dataset.id, state: tr.dataset.state }));
+    const list = [...jobList.rows.values()].map((tr) => ({ id: tr.dataset.id, state: tr.dataset.state }));
     const pick = list.find((j) => j.state === 'running') || list[0];
-    if (pick) viewer.show(pick.id);
+    if (pick) viewer.show(pick.id, { fill: true });
   }
   scheduleCheck();
 }

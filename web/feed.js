@@ -85,6 +85,14 @@ class Feed {
     }
   }
 
+  // The job is live again (continued to render more): its stream opens anew, from the kept picture.
+  reopen() {
+    if (this.closed || this.es) return;
+    this.ended = false;
+    this.emit('reopen');
+    this.start();
+  }
+
   scheduleRetry(ms = 2000) {
     clearTimeout(this.retry);
     this.setConn('reconnecting');
@@ -186,7 +194,7 @@ class Feed {
         this.history.push({ seconds: p.seconds, spp: p.spp, error: p.error });
         this.emit('history');
       }
-    } else if (s.state === 'queued' && this.history.length) {
+    } else if (s.state === 'queued' && this.history.length && !s.error_history) {
       this.history = [];
       this.emit('history');
     }

@@ -1,101 +1,25 @@
 // End-to-end test of the web page (web/) in a real browser: Debian's Chromium driven by
-// playwright-core, against a real render-server on an ephemeral loopback port with a temp data dir.
-//
-//   RENDER_SERVER   the render-server binary (default: <source>/build/render-server)
-//   PT_SOURCE_DIR   the source tree; the page is served from its web/ (default: ../.. from here)
-//   PT_WEB_ARTIFACTS  where the screenshots go (default: <source>/build/tests)
-//   CHROMIUM        the browser (default: /usr/bin/chromium)
-//
-// Exits 77 (ctest: skipped) when the browser, playwright-core or the server binary is missing;
-// under CI=true those are failures (exit 1): missing.mjs.
+// playwright-core, against a real render-server on an ephemeral loopback port with a temp data dir
+// (harness.mjs: the environment it reads, and exit 77 when something it needs is missing). The job
+// list, pause, render more and reloading a job's link: jobs.test.mjs.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
-import os from 'node:os';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { skip } from './missing.mjs';
+import { artifacts, startServer, stopServer, makeDataDir, openBrowser, apiClient, pageSteps, assertFitsWidth } from './harness.mjs';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const sourceDir = path.resolve(process.env.PT_SOURCE_DIR || path.join(here, '..', '..'));
-const serverBin = process.env.RENDER_SERVER || path.join(sourceDir, 'build', 'render-server');
-const artifacts = process.env.PT_WEB_ARTIFACTS || path.join(sourceDir, 'build', 'tests');
-const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
-
-if (!fs.existsSync(serverBin)) skip(`no render-server at ${serverBin}`);
-if (!fs.existsSync(chromiumPath)) skip(`no browser at ${chromiumPath} (apt-get install chromium)`);
-let chromium;
-try {
-  ({ chromium } = await import('playwright-core'));
-} catch (e) {
-  skip(`playwright-core is not installed (run npm ci in ${here}): ${e.message}`);
-}
-
-// Generous: ctest may run the heavy image tests beside this one on 2 cores.
-const WAIT = Number(process.env.PT_WEB_WAIT_MS) || 90_000;
-
-// ---------- the server ----------
-
-let dataDir, server, baseUrl, port;
-
-function startServer(wantedPort = 0) {
-  return new Promise((resolve, reject) => {
-    const proc = spawn(serverBin, ['--port', String(wantedPort), '--data', dataDir, '--web', path.join(sourceDir, 'web')],
-      { stdio: ['ignore', 'pipe', 'pipe'] });
-    let out = '', err = '';
-    const timer = setTimeout(() => { proc.kill('SIGKILL'); reject(new Error(`render-server did not start: ${out}${err}`)); }, 20_000);
-    proc.stdout.on('data', (d) => {
-      out += d;
-      const m = out.match(/listening on (http:\/\/127\.0\.0\.1:(\d+)\/)/);
-      if (m) {
-        clearTimeout(timer);
-        resolve({ proc, url: m[1], port: Number(m[2]) });
-      }
-    });
-    proc.stderr.on('data', (d) => { err += d; });
-    proc.on('exit', (code) => {
-      clearTimeout(timer);
-      reject(new Error(`render-server exited (${code}) before listening: ${out}${err}`));
-    });
-  });
-}
-
-function stopServer(proc) {
-  return new Promise((resolve) => {
-    if (proc.exitCode !== null || proc.signalCode !== null) return resolve();
-    const t = setTimeout(() => proc.kill('SIGKILL'), 10_000);
-    proc.once('exit', () => { clearTimeout(t); resolve(); });
-    proc.kill('SIGTERM');
-  });
-}
-
-async function apiGet(p) {
-  const r = await fetch(new URL(p, baseUrl));
-  return { status: r.status, type: r.headers.get('content-type'), body: Buffer.from(await r.arrayBuffer()) };
-}
-async function apiJson(p) {
-  const r = await fetch(new URL(p, baseUrl));
-  return r.json();
-}
-
-// ---------- the browser ----------
-
-let browser, page;
+let dataDir, server, baseUrl, port, browser, page, api;
+let fill, viewedJobId, submit, waitViewerEnded;
 const pageErrors = [];
+const apiGet = (p) => api.get(p);
+const apiJson = (p) => api.json(p);
 
 before(async () => {
-  dataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'web-test-'));
-  ({ proc: server, url: baseUrl, port } = await startServer(0));
-  const args = ['--disable-dev-shm-usage'];
-  if (process.getuid && process.getuid() === 0) args.push('--no-sandbox');
-  browser = await chromium.launch({ executablePath: chromiumPath, headless: true, args });
-  page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
-  page.setDefaultTimeout(WAIT);
-  page.on('pageerror', (e) => pageErrors.push(e.message));
-  await page.goto(baseUrl);
-  await page.waitForSelector('#conn[data-state="live"]');
-  await page.waitForSelector('#f-scene option[value="cornell"]', { state: 'attached' });
+  dataDir = makeDataDir('web-test');
+  ({ proc: server, url: baseUrl, port } = await startServer(dataDir));
+  api = apiClient(baseUrl);
+  ({ browser, page } = await openBrowser(baseUrl, pageErrors));
+  ({ fill, viewedJobId, submit, waitViewerEnded } = pageSteps(page));
 });
 
 after(async () => {
@@ -103,33 +27,6 @@ after(async () => {
   if (server) await stopServer(server);
   if (dataDir) fs.rmSync(dataDir, { recursive: true, force: true });
 });
-
-// Sets form fields (by job-field name) the way a user types them.
-async function fill(values) {
-  for (const [name, v] of Object.entries(values)) {
-    if (name === 'scene') await page.selectOption('#f-scene', v);
-    else await page.fill(`#f-${name}`, String(v));
-  }
-}
-
-async function viewedJobId() {
-  return page.evaluate(() => (location.hash.match(/job=([0-9a-f]+)/) || [])[1]);
-}
-
-async function submit(values) {
-  const before = await viewedJobId();
-  await fill(values);
-  await page.click('#submit');
-  await page.waitForFunction((prev) => {
-    const m = location.hash.match(/job=([0-9a-f]+)/);
-    return m && m[1] !== prev;
-  }, before);
-  return viewedJobId();
-}
-
-async function waitViewerEnded(state) {
-  await page.waitForSelector(`#viewer[data-ended="true"][data-state="${state}"]`);
-}
 
 // Compares a canvas on the page with the job's final image.png, decoded by the browser the same
 // way the page decodes tiles. Values are in 0..255 units.
@@ -300,7 +197,7 @@ test('the page reconnects by itself when the server restarts mid-render', async 
   // Same port, same data: the interrupted job was put back in the queue and runs again.
   for (let attempt = 0; ; ++attempt) {
     try {
-      ({ proc: server } = await startServer(port));
+      ({ proc: server } = await startServer(dataDir, port));
       break;
     } catch (e) {
       if (attempt >= 10) throw e;
@@ -321,11 +218,7 @@ test('the page reconnects by itself when the server restarts mid-render', async 
 test('a narrow window needs no sideways scrolling', async () => {
   await page.setViewportSize({ width: 390, height: 844 });
   await page.waitForTimeout(300);
-  const widths = await page.evaluate(() => [document.documentElement.scrollWidth, window.innerWidth]);
-  const wide = await page.evaluate(() => [...document.querySelectorAll('body *')]
-    .filter((el) => el.getBoundingClientRect().right > window.innerWidth + 0.5)
-    .map((el) => `${el.tagName.toLowerCase()}${el.id ? `#${el.id}` : ''}${el.className ? `.${el.className}` : ''}`));
-  assert.ok(widths[0] <= widths[1], `page is ${widths[0]} px wide in a ${widths[1]} px window: ${wide.slice(0, 8).join(', ')}`);
+  await assertFitsWidth(page, assert);
   const canvasBox = await page.locator('#v-canvas').boundingBox();
   assert.ok(canvasBox.width <= 390 && canvasBox.width > 200, `canvas ${canvasBox.width} px wide`);
   await page.screenshot({ path: path.join(artifacts, 'web-screenshot-narrow.png'), fullPage: true });
