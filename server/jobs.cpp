@@ -138,10 +138,10 @@ void JobManager::stop() {
     if (w.joinable()) w.join();
 }
 
-JobSpec JobManager::check(const json& body) const {
+JobSpec JobManager::check(const json& body) {
   JobSpec spec = parse_job_spec(body, m_config.limits);
-  if (m_scenes.resolve(spec.scene).empty())
-    throw JobError(JobErrorKind::not_found, "unknown scene '" + spec.scene + "'", "scene");
+  // A scene that does not load is refused here (422) rather than accepted as a job that fails.
+  m_scenes.check(spec.scene);
   return spec;
 }
 

@@ -108,7 +108,7 @@ class JobManager {
   // Validates and queues; returns the job and whether it was created (false: same idempotency key).
   std::pair<std::shared_ptr<Job>, bool> submit(const json& body, const std::string& idempotency_key);
   // Validates only (scene existence included); returns the normalised spec.
-  JobSpec check(const json& body) const;
+  JobSpec check(const json& body);
   std::shared_ptr<Job> get(const std::string& id) const;
   std::vector<std::shared_ptr<Job>> list() const;
   JobPage page(size_t limit, const std::string& cursor, const std::string& state) const;

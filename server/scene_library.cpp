@@ -192,34 +192,7 @@ json SceneLibrary::list() {
   json out = json::array();
   for (const std::string& name : names) {
     json item{{"name", name}};
-    // Each file is parsed once per (path, size, modification time): a broken scene of 86 MB must
-    // not be parsed again on every listing.
-    std::string path = resolve(name);
-    struct stat st {};
-    bool known = !path.empty() && stat(path.c_str(), &st) == 0;
-    FileStamp stamp{path, st.st_size, st.st_mtim.tv_sec, st.st_mtim.tv_nsec};
-    FileSummary cached;
-    bool hit = false;
-    if (known) {
-      std::lock_guard<std::mutex> lock(m_mutex);
-      auto it = m_file_summaries.find(name);
-      if (it != m_file_summaries.end() && it->second.stamp == stamp) {
-        cached = it->second;
-        hit = true;
-      }
-    }
-    if (!hit) {
-      cached.stamp = stamp;
-      try {
-        cached.summary = summary(name, &cached.hash);
-      } catch (const std::exception& e) {
-        cached.error = e.what();
-      }
-      if (known) {
-        std::lock_guard<std::mutex> lock(m_mutex);
-        m_file_summaries[name] = cached;
-      }
-    }
+    FileSummary cached = file_summary(name);
     if (!cached.error.empty()) {
       item["error"] = cached.error;
     } else {
@@ -231,6 +204,38 @@ json SceneLibrary::list() {
     out.push_back(item);
   }
   return out;
+}
+
+SceneLibrary::FileSummary SceneLibrary::file_summary(const std::string& name) {
+  // Each file is parsed once per (path, size, modification time): a broken scene of 86 MB must
+  // not be parsed again on every listing or submission.
+  std::string path = resolve(name);
+  struct stat st {};
+  bool known = !path.empty() && stat(path.c_str(), &st) == 0;
+  FileStamp stamp{path, st.st_size, st.st_mtim.tv_sec, st.st_mtim.tv_nsec};
+  if (known) {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    auto it = m_file_summaries.find(name);
+    if (it != m_file_summaries.end() && it->second.stamp == stamp) return it->second;
+  }
+  FileSummary cached;
+  cached.stamp = stamp;
+  try {
+    cached.summary = summary(name, &cached.hash);
+  } catch (const std::exception& e) {  // JobError too: a name whose file cannot be read
+    cached.error = e.what();
+  }
+  if (known) {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_file_summaries[name] = cached;
+  }
+  return cached;
+}
+
+void SceneLibrary::check(const std::string& name) {
+  if (resolve(name).empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "scene");
+  const std::string error = file_summary(name).error;
+  if (!error.empty()) throw JobError(JobErrorKind::scene_broken, "scene '" + name + "' does not load: " + error, "scene");
 }
 
 json SceneLibrary::summary(const std::string& name, uint64_t* content_hash) {

@@ -35,6 +35,9 @@ class SceneLibrary {
   // Every scene with its summary, or its load error, and the bytes of its built base while the
   // cache holds one.
   json list();
+  // Throws JobError(not_found) for an unknown name, JobError(scene_broken) naming the loader's
+  // message for a file that does not load (parsed once per file version).
+  void check(const std::string& name);
 
  private:
   using Base = std::shared_ptr<const pt::SceneBase>;
@@ -68,6 +71,9 @@ class SceneLibrary {
     std::string error;  // when it does not
     uint64_t hash = 0;
   };
+
+  // The cached summary or error of a scene file's current version.
+  FileSummary file_summary(const std::string& name);
 
   std::vector<std::string> m_dirs;  // canonical
   std::map<std::string, FileSummary> m_file_summaries;  // by scene name

@@ -40,11 +40,19 @@ def head(port, path, host):
     # A scene file in Latin-1: its bytes are not UTF-8 at all.
     (b"sol-\xe9t\xe9", "sol-\ufffdt\ufffd"),
 ])
-def test_error_text_that_is_not_utf8_fails_the_job_not_the_server(server, array_id, quoted):
+def test_error_text_that_is_not_utf8_is_refused_or_fails_the_job_not_the_server(server, array_id, quoted):
     raw = array_id.encode() if isinstance(array_id, str) else array_id
     (server.scenes / "odd.dae").write_bytes(scene_with_bad_count(raw))
     api = server.api
+    err = api.error(api.post("/api/jobs", dict(TINY, scene="odd")), 422, "scene")
+    assert "count says 13" in err["message"] and quoted in err["message"], err["message"]
+    # A scene that breaks after its job was accepted fails the job, saying why.
+    (server.scenes / "odd.dae").write_bytes(CORNELL.read_bytes())
+    blocker = api.submit(ENDLESS)
+    api.wait(blocker["id"], "running")
     job = api.submit(dict(TINY, scene="odd"))
+    (server.scenes / "odd.dae").write_bytes(scene_with_bad_count(raw))
+    api.delete(f"/api/jobs/{blocker['id']}", expect=200)
     assert server.events(job["id"]).until_end()[-1].data == {"state": "failed"}
     failed = api.job(job["id"])
     assert failed["state"] == "failed" and "count says 13" in failed["message"], failed

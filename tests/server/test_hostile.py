@@ -348,13 +348,15 @@ def test_focus_inside_the_image(srv):
     srv.api.get(f"/api/jobs/{srv.done_job['id']}/focus?x=0&y=48")  # the edges are inside
 
 
-def test_broken_scene_fails_the_job_with_its_error(srv):
+def test_a_broken_scene_is_refused_at_submit_with_its_error(srv):
     listed = {s["name"]: s for s in srv.api.get("/api/scenes").json()["scenes"]}
     assert "summary" in listed["cornell"] and "error" in listed["broken"]
     assert "escape" not in listed or "summary" not in listed["escape"]
-    job = srv.api.submit(dict(TINY, scene="broken"))
-    failed = srv.api.wait(job["id"], ("failed", "done"), timeout=20)
-    assert failed["state"] == "failed" and "broken.dae" in failed["message"]
+    jobs_before = len(srv.api.get("/api/jobs").json()["jobs"])
+    for path in ("/api/jobs", "/api/jobs/check"):
+        err = srv.api.error(srv.api.post(path, dict(TINY, scene="broken")), 422, "scene")
+        assert "broken.dae" in err["message"] and err["message"] == "scene 'broken' does not load: " + listed["broken"]["error"]
+    assert len(srv.api.get("/api/jobs").json()["jobs"]) == jobs_before, "a job was made of a broken scene"
 
 
 def test_still_healthy_and_rendering_afterwards(srv):
