@@ -28,6 +28,10 @@ class PassSource {
   virtual const Film& film() const = 0;
   virtual double seconds() const = 0;  // rendering time so far
   virtual double error_estimate() const { return film().error_estimate(); }
+  // The work left (Film::work), weighted by what a sample cost where the source knows it.
+  virtual Film::Work work() const { return film().work(); }
+  // Of seconds(), the time spent tracing caustic light paths; 0 where not timed apart.
+  virtual double light_seconds() const { return 0; }
   // Nothing left to render: every pixel done (gathered: also every pass asked for merged).
   virtual bool finished() const { return film().finished(); }
 };
