@@ -81,15 +81,6 @@ double ProgressEstimate::progress(double seconds) const {
   return (taken + since) / (taken + left);
 }
 
-double remaining_seconds(double elapsed, double progress, double error, double error_seconds, const RunLimits& limits) {
-  double eta = progress > 0 ? elapsed * (1 - progress) / progress : -1;
-  auto sooner = [&eta](double t) { eta = eta < 0 ? t : std::min(eta, t); };
-  if (limits.target_error > 0 && std::isfinite(error) && error > 0)
-    sooner(std::max(0.0, error_seconds * error / limits.target_error - elapsed));
-  if (limits.time_limit > 0) sooner(std::max(0.0, limits.time_limit - elapsed));
-  return eta;
-}
-
 int next_pass_target(int target, int spp, double error, double target_error) {
   int next = std::min(spp, target * 2);
   if (target_error > 0 && std::isfinite(error) && error > target_error) {

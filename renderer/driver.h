@@ -90,13 +90,6 @@ class ProgressEstimate {
   double m_light_left = 0;
 };
 
-// Seconds left of a progressive render `elapsed` seconds in: from the sample budget (`progress`,
-// the fraction done), or sooner from the error estimate `error` measured at `error_seconds`, which
-// an unbiased estimator's relative MSE lowers as 1/time towards limits.target_error (not a
-// sample fraction: most of the budget may never be needed), or sooner still from the time limit.
-// Negative while none of them says anything (no progress, no limit). The CLI's progress bar and
-// the job service's ETA both use it.
-double remaining_seconds(double elapsed, double progress, double error, double error_seconds, const RunLimits& limits);
 // The samples per pixel the pass after one that reached `target` aims for: twice as many (1, 2, 4,
 // ... spp), or, towards an error target, where the estimate's 1/spp decay meets it when that comes
 // sooner (a doubling could overshoot it by up to the render's whole time so far).

@@ -29,9 +29,12 @@ class EmbeddedBackend : public RenderBackend {
       session.film().read_tile(t, buf);
       sink.tile(t, buf);
     };
+    pt::ProgressEstimate estimate({job.spec.time_limit, job.spec.target_error});
     auto report = [&](double error) {
       pt::SessionStats st = session.stats();
-      return RenderReport{session.progress(), st.samples, st.rays, st.nonfinite, error};
+      estimate.update(session, st.seconds, error);
+      return RenderReport{estimate.progress(st.seconds), st.samples, st.rays, st.nonfinite, error,
+                          estimate.remaining_seconds(st.seconds)};
     };
     auto on_pass = [&](const pt::PassReport& r) { sink.pass(report(r.error)); };
     RenderResult result;

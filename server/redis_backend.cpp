@@ -138,7 +138,11 @@ class WorkerPasses : public pt::PassSource {
   bool finished() const override {
     return m_film.finished() || (m_plan.exhausted() && m_merged.size() == m_plan.issued());
   }
-  RenderReport report(double error) const { return {m_film.progress(), m_samples, m_rays, m_nonfinite, error}; }
+  RenderReport report(double error, pt::ProgressEstimate& estimate) const {
+    const double t = seconds();
+    estimate.update(*this, t, error);
+    return {estimate.progress(t), m_samples, m_rays, m_nonfinite, error, estimate.remaining_seconds(t)};
+  }
   // After the last advance: the sink has started, and the log has the job's merge costs.
   void finish(pt::StopReason why);
 
@@ -310,7 +314,8 @@ class RedisBackend : public RenderBackend {
       passes.film().read_tile(t, buf);
       sink.tile(t, buf);
     };
-    auto on_pass = [&](const pt::PassReport& r) { sink.pass(passes.report(r.error)); };
+    pt::ProgressEstimate estimate({spec.time_limit, spec.target_error});
+    auto on_pass = [&](const pt::PassReport& r) { sink.pass(passes.report(r.error, estimate)); };
     try {
       result.why = pt::run_progressive(passes, {spec.time_limit, spec.target_error}, &stop, on_tile, on_pass);
     } catch (const RedisUnreachable&) {
@@ -319,7 +324,7 @@ class RedisBackend : public RenderBackend {
     }
     passes.finish(result.why);
     result.image = passes.film().image();
-    result.report = passes.report(passes.error_estimate());
+    result.report = passes.report(passes.error_estimate(), estimate);
     result.seconds = passes.seconds();
     return result;
   }
