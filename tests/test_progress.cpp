@@ -28,7 +28,7 @@ struct SyntheticRender : PassSource {
   std::vector<double> s1, s2;
   std::vector<Tile> tiles;
   std::vector<uint64_t> tile_ns, tile_samples;
-  double clock = 0;
+  double clock = 0, light_clock = 0;  // light_clock: the part of clock spent on light paths
   SyntheticRender(int w, int h, int spp, AdaptiveRule rule)
       : m_film(w, h, spp, rule, false), rng(size_t(w) * h), s1(rng.size()), s2(rng.size()),
         tiles{{0, 0, w / 2, h}, {w / 2, 0, w, h}}, tile_ns(2), tile_samples(2) {
@@ -65,6 +65,13 @@ struct SyntheticRender : PassSource {
   const Film& film() const override { return m_film; }
   double seconds() const override { return clock; }
   Film::Work work() const override { return m_film.work(tiles, tile_ns, tile_samples); }
+  double light_seconds() const override { return light_clock; }
+  // Caustic light paths for a pass from `from` to `to` samples a pixel: `per_sample` a sample,
+  // `cost` seconds each.
+  void light_paths(uint32_t from, uint32_t to, uint64_t per_sample, double cost) {
+    m_film.add_light_paths(per_sample * (to - from));
+    clock += cost * double(per_sample * (to - from)), light_clock += cost * double(per_sample * (to - from));
+  }
 };
 
 // The left half flat (its pixels stop at the first test, 33 samples), the right half noisy: uniform
@@ -274,6 +281,25 @@ TEST(ProgressEstimate, WeighsTheSamplesLeftByTheirTilesCost) {
   const Film::Work w = r.film().work(r.tiles, ns, samples);
   EXPECT_EQ(w.left, 100u * 48);
   EXPECT_NEAR(w.cost_left, 50 * 48 * 0.5 + 50 * 48 * 1.5, 1e-9);
+}
+
+// Caustic light paths go on for the whole frame until the last pixel stops, at their own rate:
+// timed apart, they neither slow the samples' rate nor go uncounted.
+TEST(ProgressEstimate, TimesTheLightPathsLeftAtTheirOwnRate) {
+  AdaptiveRule off;
+  off.enabled = false;
+  SyntheticRender r(10, 10, 64, off);
+  const HalfNoisy noisy{10};
+  ProgressEstimate estimate;
+  for (uint32_t target = 1, from = 0; target <= 16; from = target, target *= 2) {
+    r.light_paths(from, target, 50, 1e-4);
+    r.pass(target, noisy, [](size_t) { return 1e-3; });
+    estimate.update(r, r.clock, INFINITY);
+  }
+  EXPECT_NEAR(estimate.rate(), 1e3, 1e-6);
+  // 100 pixels x 48 samples at 1 ms, and 50 x 48 light paths at 0.1 ms.
+  EXPECT_NEAR(estimate.remaining_seconds(r.clock), 4.8 + 0.24, 1e-9);
+  EXPECT_DOUBLE_EQ(estimate.progress(r.clock), r.film().progress());  // progress counts samples
 }
 
 // With an error target the error estimate's 1/time decay may end the render first; a time limit
