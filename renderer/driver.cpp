@@ -16,13 +16,69 @@ const char* stop_reason_name(StopReason r) {
   return "?";
 }
 
-double remaining_seconds(double elapsed, double progress, double error, double error_seconds, const RunLimits& limits) {
-  double eta = progress > 0 ? elapsed * (1 - progress) / progress : -1;
+void ProgressEstimate::update(const PassSource& source, double seconds, double error) {
+  if (m_history.empty()) m_history.push_back({0, 0, 0, 0});
+  const Film& film = source.film();
+  const double light_seconds = source.light_seconds();
+  m_work = source.work();
+  m_finished = source.finished();
+  m_seconds = seconds, m_error = error;
+  // Light paths so far are light_paths_for(the pass's count): the passes to the last stop, doubling
+  // from the count reached, trace as many again per sample.
+  const double light_paths = double(film.light_paths());
+  m_light_left = 0;
+  if (light_paths > 0 && m_work.reached > 0 && m_work.last_stop > m_work.reached) {
+    uint32_t to = m_work.reached;
+    while (to < m_work.last_stop) to = uint32_t(std::min<uint64_t>(film.spp(), 2ull * to));
+    m_light_left = light_paths * double(to - m_work.reached) / m_work.reached;
+  }
+  // The rates since the latest earlier update at least a fifth of the time so far back: the last
+  // pass alone, unless it was short.
+  for (size_t k = m_history.size(); k-- > 0;) {
+    const Point& p = m_history[k];
+    const double dt = seconds - p.seconds;
+    if (!(dt > 0 && (dt >= 0.2 * seconds || k == 0))) continue;
+    const double samples = double(m_work.taken) - double(p.taken);
+    const double paths = light_paths - double(p.light_paths), light_dt = light_seconds - p.light_seconds;
+    if (paths > 0 && light_dt > 0 && light_dt < dt) {
+      m_light_rate = paths / light_dt;
+      if (samples > 0) m_rate = samples / (dt - light_dt);
+    } else if (samples > 0) {  // light paths, if any, untimed: folded into the samples' rate
+      m_light_rate = 0;
+      m_rate = samples / dt;
+    }
+    break;
+  }
+  m_history.push_back({seconds, m_work.taken, film.light_paths(), light_seconds});
+}
+
+double ProgressEstimate::work_seconds(double seconds) const {
+  if (m_finished) return 0;
+  if (!(m_rate > 0)) return -1;
+  double t = m_work.cost_left / m_rate;
+  if (m_light_rate > 0) t += m_light_left / m_light_rate;
+  return std::max(0.0, t - std::max(0.0, seconds - m_seconds));
+}
+
+double ProgressEstimate::remaining_seconds(double seconds) const {
+  if (m_finished) return 0;
+  double eta = work_seconds(seconds);
   auto sooner = [&eta](double t) { eta = eta < 0 ? t : std::min(eta, t); };
-  if (limits.target_error > 0 && std::isfinite(error) && error > 0)
-    sooner(std::max(0.0, error_seconds * error / limits.target_error - elapsed));
-  if (limits.time_limit > 0) sooner(std::max(0.0, limits.time_limit - elapsed));
+  if (m_limits.target_error > 0 && std::isfinite(m_error) && m_error > 0)
+    sooner(std::max(0.0, m_seconds * m_error / m_limits.target_error - seconds));
+  if (m_limits.time_limit > 0) sooner(std::max(0.0, m_limits.time_limit - seconds));
   return eta;
+}
+
+double ProgressEstimate::progress(double seconds) const {
+  if (m_finished) return 1;
+  const double work = work_seconds(seconds), eta = remaining_seconds(seconds);
+  if (eta >= 0 && (work < 0 || eta < work)) return seconds + eta > 0 ? seconds / (seconds + eta) : 0;  // a limit decides
+  const double taken = double(m_work.taken), left = double(m_work.left);
+  if (!(taken + left > 0)) return 0;
+  // Samples since the update at the recent rate, short of the last one until the source says done.
+  const double since = std::min(m_rate * std::max(0.0, seconds - m_seconds), std::max(0.0, left - 1));
+  return (taken + since) / (taken + left);
 }
 
 int next_pass_target(int target, int spp, double error, double target_error) {

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <vector>
 
 #include "film.h"
 #include "options.h"
@@ -28,6 +29,10 @@ class PassSource {
   virtual const Film& film() const = 0;
   virtual double seconds() const = 0;  // rendering time so far
   virtual double error_estimate() const { return film().error_estimate(); }
+  // The work left (Film::work), weighted by what a sample cost where the source knows it.
+  virtual Film::Work work() const { return film().work(); }
+  // Of seconds(), the time spent tracing caustic light paths; 0 where not timed apart.
+  virtual double light_seconds() const { return 0; }
   // Nothing left to render: every pixel done (gathered: also every pass asked for merged).
   virtual bool finished() const { return film().finished(); }
 };
@@ -42,13 +47,49 @@ struct PassReport {
   bool completed;   // false: cut short by a cancel or the time limit
 };
 
-// Seconds left of a progressive render `elapsed` seconds in: from the sample budget (`progress`,
-// the fraction done), or sooner from the error estimate `error` measured at `error_seconds`, which
-// an unbiased estimator's relative MSE lowers as 1/time towards limits.target_error (not a
-// sample fraction: most of the budget may never be needed), or sooner still from the time limit.
-// Negative while none of them says anything (no progress, no limit). The CLI's progress bar and
-// the job service's ETA both use it.
-double remaining_seconds(double elapsed, double progress, double error, double error_seconds, const RunLimits& limits);
+// The render's progress and time to go, for every front end (the CLI's bar and log, the window's
+// title, the job service's progress and ETA). The work left is the samples the running pixels are
+// expected to take still, each by the adaptive rule on its own statistics (Film::work), not the
+// sample budget: the cheap pixels stop first, and the noisy ones are left. Its time is those
+// samples at the camera sample rate of the last passes (at least a fifth of the time so far, not
+// the whole run, which early passes over cheap pixels inflate), each weighted by its tile's cost
+// per sample in the last pass where the source times tiles (the noisy pixels left may be dearer or
+// cheaper than the pass's mean); plus the caustic light paths, which go on for the whole frame
+// until the last pixel stops (passes of 2x, as the driver runs them), at their own rate. The error
+// target (an unbiased estimator's relative MSE falls as 1/time) or the time limit end it sooner
+// where they come first. Updated between passes; read at any time until the next update.
+class ProgressEstimate {
+ public:
+  explicit ProgressEstimate(const RunLimits& limits = {}) : m_limits(limits) {}
+  // After a pass: the source `seconds` into the render, the pass's error estimate. A render that
+  // does not start from nothing (a checkpoint) calls it once before its first pass.
+  void update(const PassSource& source, double seconds, double error);
+  // Fraction done at `seconds`: samples taken / (taken + left), counting on at the recent rate
+  // since the update; where a limit ends the render first, the share of its expected time. 1 when
+  // finished, 0 before the first update.
+  double progress(double seconds) const;
+  // Seconds left at `seconds`: 0 when finished; negative while nothing says (no rate, no limit).
+  double remaining_seconds(double seconds) const;
+  const Film::Work& work() const { return m_work; }
+  double rate() const { return m_rate; }  // camera samples a second over the last passes; 0: unknown
+
+ private:
+  double work_seconds(double seconds) const;  // the work left's time, or -1
+
+  struct Point {
+    double seconds;
+    uint64_t taken, light_paths;
+    double light_seconds;
+  };
+  RunLimits m_limits;
+  std::vector<Point> m_history;
+  Film::Work m_work;
+  bool m_finished = false;
+  double m_seconds = 0, m_error = INFINITY;
+  double m_rate = 0, m_light_rate = 0;  // camera samples, light paths a second (0: unknown)
+  double m_light_left = 0;
+};
+
 // The samples per pixel the pass after one that reached `target` aims for: twice as many (1, 2, 4,
 // ... spp), or, towards an error target, where the estimate's 1/spp decay meets it when that comes
 // sooner (a doubling could overshoot it by up to the render's whole time so far).

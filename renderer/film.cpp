@@ -102,6 +102,36 @@ double Film::progress() const {
   return total > 0 ? std::min(1.0, done / total) : 1.0;
 }
 
+Film::Work Film::work(const std::vector<Tile>& tiles, const std::vector<uint64_t>& tile_ns,
+                      const std::vector<uint64_t>& tile_samples) const {
+  Work w;
+  const uint32_t spp = uint32_t(m_spp);
+  auto add = [&](size_t i, double cost) {
+    const uint32_t n = m_count[i];
+    w.taken += n;
+    w.reached = std::max(w.reached, n);
+    if (m_done[i]) return;
+    const uint32_t stop = m_rule.predicted_stop(m_s1[i], m_s2[i], n, spp), left = stop - std::min(n, spp);
+    w.left += left;
+    w.cost_left += cost * left;
+    w.last_stop = std::max(w.last_stop, stop);
+  };
+  double ns = 0, samples = 0;
+  if (tile_ns.size() == tiles.size() && tile_samples.size() == tiles.size())
+    for (size_t t = 0; t < tiles.size(); ++t)
+      if (tile_samples[t] > 0) ns += double(tile_ns[t]), samples += double(tile_samples[t]);
+  if (!(ns > 0)) {
+    for (size_t i = 0; i < m_count.size(); ++i) add(i, 1.0);
+    return w;
+  }
+  for (size_t t = 0; t < tiles.size(); ++t) {
+    const double cost = tile_samples[t] > 0 ? double(tile_ns[t]) / double(tile_samples[t]) * samples / ns : 1.0;
+    for (int y = tiles[t].y0; y < tiles[t].y1; ++y)
+      for (int x = tiles[t].x0; x < tiles[t].x1; ++x) add(size_t(y) * m_w + x, cost);
+  }
+  return w;
+}
+
 void Film::begin_light_paths() {
   if (m_lt_paths > 0 && m_lt_paths >= 2 * m_lt_half_paths) {
     m_lt_half_s1 = m_lt_s1;

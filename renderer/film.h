@@ -42,6 +42,25 @@ struct AdaptiveRule {
     double var = std::max(0.0, (s2 - s1 * s1 / n) / (n - 1));
     return 1.96 * std::sqrt(var / n) <= tolerance * mu;
   }
+  // The count at which a running pixel of n samples (sums s1, s2) is expected to stop within a
+  // budget of spp: the test above solved for n, n >= (1.96 sigma / (tolerance mu))^2, on its
+  // statistics so far, at the first test due there and after n. The budget where nothing can be
+  // said yet (n < 2) or the test cannot pass (a mean <= 0 with spread).
+  uint32_t predicted_stop(double s1, double s2, uint32_t n, uint32_t spp) const {
+    if (n >= spp) return n;
+    if (!enabled || n < 2) return spp;
+    const double mu = s1 / n, var = std::max(0.0, (s2 - s1 * s1 / n) / (n - 1));
+    double need = 0;  // no spread: the next test passes (for a mean >= 0)
+    if (var > 0 || mu < 0) {
+      if (!(mu > 0 && tolerance > 0)) return spp;
+      const double z = 1.96 / tolerance;
+      need = z * z * var / (mu * mu);
+    }
+    if (!(need < double(spp))) return spp;
+    uint32_t at = next_test(n);
+    if (need > at) at = 1 + batch * uint32_t((std::ceil(need) - 1 + batch - 1) / batch);
+    return std::min(at, spp);
+  }
 };
 
 // The last error estimate of statistics that have not changed since. A render's callers ask
@@ -141,8 +160,21 @@ class Film {
   void skip(const std::vector<uint8_t>& skip);
   bool finished() const;     // every pixel done
   size_t remaining() const;  // pixels still taking samples
-  // Fraction of the sample budget done, converged pixels counted in full.
+  // Fraction of the sample budget done, converged pixels counted in full: the budget's share, not
+  // the render's (ProgressEstimate, driver.h, counts the work left).
   double progress() const;
+  // Samples taken, those the running pixels are expected to take still (predicted_stop), the
+  // most any pixel has (the last pass's count) and the latest predicted stop (0: none runs).
+  struct Work {
+    uint64_t taken = 0, left = 0;
+    double cost_left = 0;  // `left`, each sample weighted by its tile's cost (1 without)
+    uint32_t reached = 0, last_stop = 0;
+  };
+  // One pass over the per-pixel arrays: call between passes. Where `tiles` (which cover the film)
+  // come with the time and samples each took in its last pass, a sample left costs its tile's time
+  // per sample over the mean of the tiles that took samples.
+  Work work(const std::vector<Tile>& tiles = {}, const std::vector<uint64_t>& tile_ns = {},
+            const std::vector<uint64_t>& tile_samples = {}) const;
 
   // ---- light-traced caustics (caustics.h) ----
   bool has_caustics() const { return !m_lt_sum.empty(); }

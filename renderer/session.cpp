@@ -50,6 +50,7 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
   find_scene_rectangle();
   // Before any pass, a tile's cost is its pixels that see the scene.
   m_tile_ns.assign(m_tiles.size(), 0);
+  m_tile_samples.assign(m_tiles.size(), 0);
   for (size_t t = 0; t < m_tiles.size(); ++t) {
     const Tile& tile = m_tiles[t];
     uint64_t seen = 0;
@@ -234,7 +235,10 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
   target_spp = std::min(target_spp, m_params.spp);
   auto start = std::chrono::steady_clock::now();
   m_film.invalidate_estimate();
-  if (m_path.caustics_light_traced) trace_caustics(target_spp, cancel);
+  if (m_path.caustics_light_traced) {
+    trace_caustics(target_spp, cancel);
+    m_light_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   std::atomic<size_t> next{0};
   auto worker = [&]() {
     const uint64_t cpu_start = thread_cpu_ns();
@@ -245,8 +249,10 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
       if (stop_requested(cancel)) break;
       const uint32_t ti = m_tile_order[k];
       const auto t0 = std::chrono::steady_clock::now();
+      const uint64_t samples_before = samples;
       render_tile(m_tiles[ti], target_spp, cancel, rays, samples, nonfinite);
       m_tile_ns[ti] = uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count());
+      m_tile_samples[ti] = samples - samples_before;
       if (on_tile && !stop_requested(cancel)) on_tile(m_tiles[ti]);
     }
     m_rays += rays;
@@ -291,6 +297,8 @@ double RenderSession::progress() const {
   double total = double(m_params.spp) * double(m_film.pixels());
   return total > 0 ? std::min(1.0, double(m_budget_done.load()) / total) : 1.0;
 }
+
+Film::Work RenderSession::work() const { return m_film.work(m_tiles, m_tile_ns, m_tile_samples); }
 
 void RenderSession::set_sample_range(uint32_t first, const std::vector<uint8_t>& skip) {
   m_first_sample = first;

@@ -52,6 +52,9 @@ class RenderSession : public PassSource {
   // Estimated relative MSE of the image (Film::error_estimate), on the render threads.
   double error_estimate() const override { return m_film.error_estimate(m_params.threads); }
   bool finished() const override { return m_film.finished(); }
+  // Each sample left weighted by its tile's time per sample in the last pass that reached it.
+  Film::Work work() const override;
+  double light_seconds() const override { return m_light_seconds; }  // since this object began
 
   const RenderParams& params() const { return m_params; }
   const RenderScene& scene() const { return m_scene; }
@@ -132,12 +135,13 @@ class RenderSession : public PassSource {
   // anomalies", SIAM J. Appl. Math. 17, 1969). The image does not depend on the order.
   std::vector<uint32_t> m_tile_order;
   std::vector<uint64_t> m_tile_ns;  // each tile's render time in the last pass that reached it
+  std::vector<uint64_t> m_tile_samples;  // and the samples it took there
   CausticFilm m_caustic_film;
   uint64_t m_lt_issued = 0;  // light paths issued (a cancelled chunk's are skipped, not retried)
   std::atomic<uint64_t> m_samples{0}, m_rays{0}, m_nonfinite{0};
   std::atomic<uint64_t> m_budget_done{0};  // pixel-samples done, converged pixels counted in full
   std::atomic<uint64_t> m_cpu_ns{0};      // SessionStats::cpu_seconds
-  double m_seconds = 0;
+  double m_seconds = 0, m_light_seconds = 0;
   int m_passes = 0;
   std::chrono::steady_clock::time_point m_deadline = std::chrono::steady_clock::time_point::max();
   bool stop_requested(const std::atomic<bool>* cancel) const {

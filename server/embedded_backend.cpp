@@ -52,9 +52,12 @@ class EmbeddedBackend : public RenderBackend {
       session->film().read_tile(t, buf);
       sink.tile(t, buf);
     };
+    pt::ProgressEstimate estimate({job.spec.time_limit, job.spec.target_error});
     auto report = [&](double error) {
       pt::SessionStats st = session->stats();
-      return RenderReport{session->progress(), st.samples, st.rays, st.nonfinite, error};
+      estimate.update(*session, st.seconds, error);
+      return RenderReport{estimate.progress(st.seconds), st.samples, st.rays, st.nonfinite, error,
+                          estimate.remaining_seconds(st.seconds)};
     };
     if (resumed) {  // the checkpoint's picture and counts, before the first new pass
       std::fprintf(stderr, "render-server: job %s: resuming from its checkpoint (%.1f spp a pixel, %.2f s rendered)\n",

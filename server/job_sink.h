@@ -64,7 +64,9 @@ class JobStateSink : public JobSink {
         }
       j.region_version[size_t(t.y0 / j.region_size) * j.regions_x + t.x0 / j.region_size] = ++j.version;
       j.has_image = true;
-      j.elapsed = seconds();
+      const double now = seconds();
+      if (j.eta > 0) j.eta = std::max(0.0, j.eta - (now - j.elapsed));  // the last pass's, counted down
+      j.elapsed = now;
     }
     // Every notify wakes every watcher, and each takes the job's mutex the render threads need:
     // tile updates wake them at most every kTileNotifyGap (watchers batch tiles over 40 ms rounds
@@ -86,10 +88,7 @@ class JobStateSink : public JobSink {
         j.error_estimate = r.error;
         j.history.push_back({j.elapsed, double(r.samples) / (double(j.width) * j.height), r.error});
       }
-      pt::RunLimits limits;
-      limits.target_error = j.spec.target_error;
-      limits.time_limit = j.spec.time_limit;
-      j.eta = pt::remaining_seconds(j.elapsed, j.progress, r.error, j.elapsed, limits);
+      j.eta = r.eta;
       ++j.version;
       ++j.passes;
       if (std::chrono::steady_clock::now() - m_last_persist > std::chrono::seconds(1)) {

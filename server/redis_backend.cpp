@@ -157,7 +157,11 @@ class WorkerPasses : public pt::PassSource {
   bool finished() const override {
     return m_film.finished() || (m_plan.exhausted() && m_merged.size() == m_plan.issued());
   }
-  RenderReport report(double error) const { return {m_film.progress(), m_samples, m_rays, m_nonfinite, error}; }
+  RenderReport report(double error, pt::ProgressEstimate& estimate) const {
+    const double t = seconds();
+    estimate.update(*this, t, error);
+    return {estimate.progress(t), m_samples, m_rays, m_nonfinite, error, estimate.remaining_seconds(t)};
+  }
   // After the last advance: the sink has started, and the log has the job's merge costs.
   void finish(pt::StopReason why);
   // Checkpoints: the merged film, the passes issued and which of them were merged. A restored run
@@ -171,6 +175,7 @@ class WorkerPasses : public pt::PassSource {
     m_started = true;
   }
   bool started() const { return m_started; }
+  uint64_t samples() const { return m_samples; }
   const std::vector<pt::Tile>& tiles() const { return m_tiles; }
 
  private:
@@ -374,6 +379,7 @@ class RedisBackend : public RenderBackend {
       passes.film().read_tile(t, buf);
       sink.tile(t, buf);
     };
+    pt::ProgressEstimate estimate({spec.time_limit, spec.target_error});
     if (!plan.path.empty() && restore(plan.path, fingerprint, job, passes)) {
       std::vector<std::string> features;
       {
@@ -382,7 +388,7 @@ class RedisBackend : public RenderBackend {
       }
       passes.resumed(features);
       for (const pt::Tile& t : passes.tiles()) on_tile(t);
-      sink.pass(passes.report(passes.error_estimate()));
+      sink.pass(passes.report(passes.error_estimate(), estimate));
     }
     RenderResult result;
     auto last_save = std::chrono::steady_clock::now();
@@ -397,7 +403,7 @@ class RedisBackend : public RenderBackend {
         out.text(kCheckpointMagic), out.text(fingerprint);
         passes.save(out);
         write_file_atomic(plan.path, out.bytes());
-        sink.checkpointed(passes.report(INFINITY).samples, passes.seconds());
+        sink.checkpointed(passes.samples(), passes.seconds());
       } catch (const std::exception& e) {  // costs the resume, not the render
         std::fprintf(stderr, "render-server: job %s: %s\n", job.id.c_str(), e.what());
       }
@@ -406,7 +412,7 @@ class RedisBackend : public RenderBackend {
     try {
       while (!driver.done()) {
         const pt::PassReport r = driver.step(&stop, on_tile);
-        sink.pass(passes.report(r.error));
+        sink.pass(passes.report(r.error, estimate));
         if (!r.completed) break;
         save(false);
       }
@@ -418,7 +424,7 @@ class RedisBackend : public RenderBackend {
     save(true);  // a pause, a restart or a continue takes the merged film from here
     passes.finish(result.why);
     result.image = passes.film().image();
-    result.report = passes.report(passes.error_estimate());
+    result.report = passes.report(passes.error_estimate(), estimate);
     result.seconds = passes.seconds();
     return result;
   }
@@ -438,7 +444,7 @@ class RedisBackend : public RenderBackend {
       passes.restore(in);
       if (!in.at_end()) in.fail("bytes past the end");
       std::fprintf(stderr, "render-server: job %s: resuming from its checkpoint (%.1f spp a pixel, %.2f s rendered)\n",
-                   job.id.c_str(), double(passes.report(INFINITY).samples) / double(passes.film().pixels()),
+                   job.id.c_str(), double(passes.samples()) / double(passes.film().pixels()),
                    passes.seconds());
       return true;
     } catch (const std::exception& e) {

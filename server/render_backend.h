@@ -17,9 +17,10 @@ class SceneLibrary;
 struct Job;
 
 struct RenderReport {
-  double progress = 0;  // fraction of the sample budget done
+  double progress = 0;  // fraction of the work done (pt::ProgressEstimate)
   uint64_t samples = 0, rays = 0, nonfinite = 0;
   double error = INFINITY;  // the error estimate (relMSE) after the last merged pass
+  double eta = -1;          // seconds left (pt::ProgressEstimate); negative when unknown
 };
 
 class JobSink {

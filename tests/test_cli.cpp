@@ -12,6 +12,7 @@
 
 #include <OpenImageIO/imageio.h>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -364,6 +365,50 @@ TEST(Cli, ErrorLogTargetErrorAndReference) {
   EXPECT_NE(r.output.find("ref.exr"), std::string::npos) << r.output;
 }
 
+// --progress-log: the bar's fraction and ETA (ProgressEstimate) row by row, known from the first
+// pass on, ending at 1 and 0 s with the last pass; beside them the sample budget's fraction and
+// the samples taken and predicted left, none left at the end.
+TEST(Cli, ProgressLogFollowsTheRenderToItsEnd) {
+  std::string dir = test::temp_dir();
+  RunResult r = run("-t 2 -s 256 -m 2 -r 40 30 --keep-fov --quiet --progress-log " + dir + "/progress.csv -f " + dir +
+                    "/run.png " + test::own_scene("dof.dae"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream in(dir + "/progress.csv");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "seconds,progress,eta,budget_progress,pass_end,samples,samples_left");
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+    ASSERT_EQ(row.size(), 7u) << line;
+    for (double v : row) ASSERT_TRUE(std::isfinite(v)) << line;
+    rows.push_back(row);
+  }
+  ASSERT_GE(rows.size(), 2u);
+  int passes = 0;
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const std::vector<double>& row = rows[k];
+    if (k > 0) EXPECT_GE(row[0], rows[k - 1][0]) << k;
+    EXPECT_GE(row[1], 0) << k;
+    EXPECT_LE(row[1], 1) << k;
+    EXPECT_GE(row[3], 0) << k;
+    EXPECT_LE(row[3], 1) << k;
+    if (passes > 0) EXPECT_GE(row[2], 0) << k << ": the first pass gave a rate";
+    passes += row[4] == 1;
+  }
+  EXPECT_GE(passes, 2);
+  EXPECT_LE(passes, 9);  // 1, 2, 4, ... 256 spp at most
+  EXPECT_EQ(rows.back()[4], 1);
+  EXPECT_EQ(rows.back()[1], 1);
+  EXPECT_EQ(rows.back()[2], 0);
+  EXPECT_EQ(rows.back()[3], 1);
+  EXPECT_GT(rows.back()[5], 0);
+  EXPECT_LE(rows.back()[5], 256 * 40 * 30);
+  EXPECT_EQ(rows.back()[6], 0);
+}
+
 // Runs argv[0] with argv on a pseudo-terminal (where the progress bar draws) and returns what it
 // wrote there, stdout and stderr together.
 std::string run_on_terminal(const std::vector<std::string>& argv, int& status) {
@@ -396,7 +441,7 @@ std::string run_on_terminal(const std::vector<std::string>& argv, int& status) {
 }
 
 // On a terminal the progress bar shows the latest error estimate, and with --target-error its ETA
-// follows that estimate's 1/time decay (remaining_seconds, whose arithmetic test_error.cpp checks),
+// follows that estimate's 1/time decay (ProgressEstimate, whose arithmetic test_progress.cpp checks),
 // not the sample budget; so does its fill, elapsed / (elapsed + ETA). A budget of 2^20 spp, which
 // the target ends at a few thousand, would keep the fill at the sample fraction, under 1%: the fill
 // must pass ten times the share of the budget the run used. Nothing here depends on how fast the

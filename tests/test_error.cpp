@@ -236,26 +236,6 @@ TEST(ErrorEstimateText, ANumberOrNotAvailableNeverInf) {
   EXPECT_EQ(format_error_estimate(NAN), "n/a");
 }
 
-// The ETA of a progressive render: from the sample budget, sooner from the error estimate's 1/time
-// decay towards a target, sooner still from a time limit; negative while nothing is known.
-TEST(RemainingSeconds, FollowsTheBudgetTheErrorsDecayAndTheTimeLimit) {
-  const RunLimits none;
-  EXPECT_LT(remaining_seconds(1.0, 0.0, INFINITY, 0.0, none), 0);
-  EXPECT_NEAR(remaining_seconds(2.0, 0.25, 0.1, 2.0, none), 6.0, 1e-9);  // a quarter done in 2 s
-  RunLimits target;
-  target.target_error = 0.01;
-  // 0.04 at 2 s reaches 0.01 at 8 s: 6 s left, sooner than the budget's 18 s; 5 s left at 3 s.
-  EXPECT_NEAR(remaining_seconds(2.0, 0.1, 0.04, 2.0, target), 6.0, 1e-9);
-  EXPECT_NEAR(remaining_seconds(3.0, 0.1, 0.04, 2.0, target), 5.0, 1e-9);
-  EXPECT_NEAR(remaining_seconds(2.0, 0.1, 0.005, 2.0, target), 0.0, 1e-9);     // already below the target
-  EXPECT_NEAR(remaining_seconds(2.0, 0.5, 0.04, 2.0, target), 2.0, 1e-9);      // the budget ends sooner
-  EXPECT_NEAR(remaining_seconds(2.0, 0.5, INFINITY, 2.0, target), 2.0, 1e-9);  // no estimate yet
-  RunLimits limit;
-  limit.time_limit = 3.0;
-  EXPECT_NEAR(remaining_seconds(2.0, 0.1, 0.04, 2.0, limit), 1.0, 1e-9);
-  EXPECT_NEAR(remaining_seconds(5.0, 0.0, INFINITY, 0.0, limit), 0.0, 1e-9);  // past the limit
-}
-
 // Towards an error target a pass aims where the estimate's 1/spp decay meets the target when that
 // comes sooner than doubling, so that the render stops near the target, not up to a doubling past.
 TEST(NextPassTarget, AimsWhereTheErrorMeetsTheTargetWhenThatIsSoonerThanDoubling) {

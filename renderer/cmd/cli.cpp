@@ -95,6 +95,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     }
     else if (a == "--describe") { o.describe = true; }
     else if (a == "--error-log") { need(a, 1); o.error_log = args[++i]; }
+    else if (a == "--progress-log") { need(a, 1); o.progress_log = args[++i]; }
     else if (a == "--reference") { need(a, 1); o.reference = args[++i]; }
     else if (a == "--target-error") { need(a, 1); o.limits.target_error = parse_option(a, "target_error", args[++i]); }
     else if (a == "--time-limit") { need(a, 1); o.limits.time_limit = parse_option(a, "time_limit", args[++i]); }
@@ -161,8 +162,12 @@ std::string usage_text(const std::string& program) {
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"
 "\n"
-"Error against run time (--error-log and --reference with -f; the window honours the two limits):\n"
+"Error and progress against run time (the logs and --reference with -f; the window honours the limits):\n"
 "  --error-log <FILE>     write one CSV row per pass: seconds, spp, error estimate (+ true error)\n"
+"  --progress-log <FILE>  write CSV rows of the progress bar, after each pass and up to 10 a second\n"
+"                         between: seconds, progress, ETA (-1: unknown), the sample budget's\n"
+"                         fraction, 1 at a pass's end, the samples taken and predicted still to take\n"
+"                         at the last pass's end\n"
 "  --target-error <X>     stop once the estimated relative MSE is <= X\n"
 "  --time-limit <SEC>     stop after SEC seconds of rendering\n"
 "  --reference <FILE>     a converged image of the same size: log its true RMSE and relative MSE\n"

@@ -18,6 +18,7 @@ struct CliOptions {
   std::string script;      // --script: window input replayed from a file (tests)
   bool describe = false;   // --describe: print the feature set and memory, no render
   std::string error_log;   // --error-log: CSV of the error per pass
+  std::string progress_log;  // --progress-log: CSV of the progress bar's fraction and ETA
   std::string reference;   // --reference: true error against this image
   RunLimits limits;        // --target-error, --time-limit
   std::string checkpoint;  // --checkpoint: resume from and save to this file

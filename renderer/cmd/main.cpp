@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <string>
 
@@ -121,22 +122,58 @@ int main(int argc, char** argv) {
     }
     ProgressBar bar("Rendering", !o.quiet);
     double pixels = double(session.width()) * session.height();
-    // The bar shows the latest pass's error estimate, and its ETA follows that estimate's decay
-    // towards --target-error (remaining_seconds), not only the sample budget; so does its fill, the
-    // share of the expected time gone (the sample fraction itself when the budget decides).
+    // The driver stepped here rather than by run_progressive: a checkpoint goes between passes.
+    ProgressiveDriver driver(session, o.limits);
+    std::unique_ptr<Checkpointer> checkpoints;
+    bool restored = false;
+    if (!o.checkpoint.empty()) {
+      std::ifstream scene_file(o.scene_path, std::ios::binary);
+      checkpoints = std::make_unique<Checkpointer>(
+          o.checkpoint, render_fingerprint(std::string(std::istreambuf_iterator<char>(scene_file), {}), o.params),
+          o.checkpoint_interval);
+      restored = checkpoints->restore(session, driver);
+      if (restored && !o.quiet)
+        std::fprintf(stderr, "Resuming from %s: %.1f spp a pixel, %.2f s rendered\n", o.checkpoint.c_str(),
+                     session.stats().samples / pixels, session.seconds());
+    }
+    // The bar, its log and the ETA follow the render's ProgressEstimate (driver.h), on a clock of
+    // rendering time that goes on from a checkpoint's, as the time limit does.
+    const double resumed = session.seconds();
     const auto render_start = std::chrono::steady_clock::now();
-    auto since_start = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count(); };
-    std::atomic<double> last_error{INFINITY}, last_error_at{0};
+    auto clock = [&] { return resumed + std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count(); };
+    ProgressEstimate estimate(o.limits);
+    if (restored) estimate.update(session, resumed, session.error_estimate());
+    std::atomic<double> last_error{INFINITY};
+    FILE* progress_log = nullptr;
+    if (!o.progress_log.empty()) {
+      progress_log = std::fopen(o.progress_log.c_str(), "w");
+      if (!progress_log) throw std::runtime_error(o.progress_log + ": cannot write the progress log");
+      std::fprintf(progress_log, "seconds,progress,eta,budget_progress,pass_end,samples,samples_left\n");
+    }
+    std::mutex log_mutex;
+    double logged_at = -1;
+    auto log_progress = [&](double t, double fraction, double eta, bool pass_end) {
+      std::lock_guard<std::mutex> lock(log_mutex);
+      if (!pass_end && t < logged_at + 0.1) return;  // tiles: 10 rows a second at most
+      logged_at = t;
+      const Film::Work& work = estimate.work();  // as of the last pass's end
+      std::fprintf(progress_log, "%.4f,%.6f,%.4f,%.6f,%d,%llu,%llu\n", t, fraction, eta, session.progress(),
+                   int(pass_end), (unsigned long long)work.taken, (unsigned long long)work.left);
+      if (pass_end) std::fflush(progress_log);
+    };
     auto on_tile = [&](const Tile&) {
-      const double err = last_error.load(), elapsed = since_start(), progress = session.progress();
-      const double eta = remaining_seconds(elapsed, progress, err, last_error_at.load(), o.limits);
+      const double t = clock(), eta = estimate.remaining_seconds(t);
+      const double fraction = estimate.progress(t);
+      if (progress_log) log_progress(t, fraction, eta, false);
       // Below 1 until done: the bar redraws at once for 1, which would be every tile.
-      const double fill = std::min(0.999, eta >= 0 && elapsed + eta > 0 ? elapsed / (elapsed + eta) : progress);
-      bar.update(fill, std::isfinite(err) ? "error " + format_error_estimate(err) : std::string(), eta);
+      const double err = last_error.load();
+      bar.update(std::min(0.999, fraction), std::isfinite(err) ? "error " + format_error_estimate(err) : std::string(), eta);
     };
     auto on_pass = [&](const PassReport& r) {
-      last_error_at = since_start();
+      const double t = clock();
+      estimate.update(session, t, r.error);
       last_error = r.error;
+      if (progress_log) log_progress(t, estimate.progress(t), estimate.remaining_seconds(t), true);
       if (!log) return;
       std::fprintf(log, "%.6f,%.4f,%.6g", r.seconds, session.stats().samples / pixels, r.error);
       if (!reference.pixels.empty()) {
@@ -146,18 +183,6 @@ int main(int argc, char** argv) {
       std::fprintf(log, "\n");
       std::fflush(log);
     };
-    // The driver stepped here rather than by run_progressive: a checkpoint goes between passes.
-    ProgressiveDriver driver(session, o.limits);
-    std::unique_ptr<Checkpointer> checkpoints;
-    if (!o.checkpoint.empty()) {
-      std::ifstream scene_file(o.scene_path, std::ios::binary);
-      checkpoints = std::make_unique<Checkpointer>(
-          o.checkpoint, render_fingerprint(std::string(std::istreambuf_iterator<char>(scene_file), {}), o.params),
-          o.checkpoint_interval);
-      if (checkpoints->restore(session, driver) && !o.quiet)
-        std::fprintf(stderr, "Resuming from %s: %.1f spp a pixel, %.2f s rendered\n", o.checkpoint.c_str(),
-                     session.stats().samples / pixels, session.seconds());
-    }
     while (!driver.done()) {
       const PassReport r = driver.step(nullptr, on_tile);
       on_pass(r);
@@ -167,6 +192,7 @@ int main(int argc, char** argv) {
     const StopReason why = driver.reason();
     bar.finish();
     if (log) std::fclose(log);
+    if (progress_log) std::fclose(progress_log);
 
     Metadata meta = render_metadata(o, session);
     meta.push_back({"pathtracer:stopped", stop_reason_name(why)});

@@ -406,6 +406,9 @@ class Viewer {
       char spp[64];
       if (current && st.finished)
         std::snprintf(spp, sizeof spp, "%d/%d spp done", st.reached_spp, st.spp);
+      else if (current && st.eta >= 0)  // counted down since the pass that made it
+        std::snprintf(spp, sizeof spp, "%d/%d spp, %.0f%%, ETA %.0fs", st.reached_spp, st.spp, 100 * st.progress,
+                      std::max(0.0, st.eta - ms_since(st.at) / 1000));
       else if (current)
         std::snprintf(spp, sizeof spp, "%d/%d spp", st.reached_spp, st.spp);
       else

@@ -87,6 +87,10 @@ void RenderLoop::loop() {
       st.error = r.error;
       st.finished = m_driver->done();
       st.seconds = r.seconds;
+      m_estimate.update(*s, r.seconds, r.error);
+      st.progress = m_estimate.progress(r.seconds);
+      st.eta = m_estimate.remaining_seconds(r.seconds);
+      st.at = Clock::now();
       m_status = st;
       m_done = st.finished;
       const StopReason why = m_driver->reason();
@@ -108,6 +112,7 @@ void RenderLoop::start_session(const RenderParams& p, uint64_t gen) {
   m_driver.reset();
   m_session = std::make_unique<RenderSession>(m_scene, p);
   m_driver = std::make_unique<ProgressiveDriver>(*m_session, m_options.limits);
+  m_estimate = ProgressEstimate(m_options.limits);
   m_params = p;
   m_gen = gen;
   m_done = false;

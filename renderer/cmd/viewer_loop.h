@@ -49,6 +49,10 @@ struct Status {
   int reached_spp = 0;   // the last completed pass's target
   bool finished = false;
   double error = INFINITY, seconds = 0;
+  // The render's ProgressEstimate after the last pass, and when it was read: the title counts
+  // the ETA down from there.
+  double progress = 0, eta = -1;
+  Clock::time_point at{};
 };
 
 enum class CommandKind { focus, save };
@@ -100,6 +104,7 @@ class RenderLoop {
   Shared& m_sh;
   std::unique_ptr<RenderSession> m_session;
   std::unique_ptr<ProgressiveDriver> m_driver;  // the session's passes and stop rules
+  ProgressEstimate m_estimate;
   RenderParams m_params;
   uint64_t m_gen = 0;
   bool m_done = false;

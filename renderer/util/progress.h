@@ -18,7 +18,8 @@ class ProgressBar {
   ~ProgressBar() { finish(); }
 
   // fraction in [0, 1]; redraws at most 10 times a second. Safe from several threads. The ETA is
-  // `eta` seconds where that is given (>= 0), else the time the remaining fraction would take.
+  // `eta` seconds where that is given (>= 0), else the time the remaining fraction would take ("?"
+  // before any).
   void update(double fraction, const std::string& extra = "", double eta = -1) {
     if (!m_enabled) return;
     std::lock_guard<std::mutex> lock(m_mutex);
@@ -26,13 +27,15 @@ class ProgressBar {
     if (fraction < 1 && now - m_last < std::chrono::milliseconds(100)) return;
     m_last = now;
     double elapsed = std::chrono::duration<double>(now - m_start).count();
-    if (eta < 0) eta = fraction > 1e-6 ? elapsed * (1 - fraction) / fraction : 0;
+    if (eta < 0 && fraction > 1e-6) eta = elapsed * (1 - fraction) / fraction;
     const int width = 30;
     int filled = int(fraction * width + 0.5);
     std::string bar(size_t(filled), '#');
     bar.append(size_t(width - filled), '.');
-    std::fprintf(stderr, "\r%s [%s] %5.1f%%  %.1fs elapsed, ETA %.1fs %s\x1b[K", m_label.c_str(), bar.c_str(),
-                 100 * fraction, elapsed, eta, extra.c_str());
+    char eta_text[32] = "?";  // nothing done yet, nothing known
+    if (eta >= 0) std::snprintf(eta_text, sizeof eta_text, "%.1fs", eta);
+    std::fprintf(stderr, "\r%s [%s] %5.1f%%  %.1fs elapsed, ETA %s %s\x1b[K", m_label.c_str(), bar.c_str(),
+                 100 * fraction, elapsed, eta_text, extra.c_str());
     std::fflush(stderr);
     m_drawn = true;
   }
