@@ -16,7 +16,7 @@ namespace pt {
 
 namespace {
 
-constexpr char kMagic[8] = {'P', 'T', 'C', 'H', 'E', 'C', 'K', '1'};
+constexpr char kMagic[8] = {'P', 'T', 'C', 'H', 'E', 'C', 'K', '2'};
 constexpr size_t kMaxFingerprint = 1 << 16;
 
 // FNV-1a, 64 bits: a scene's identity, not a defence against forgery (a checkpoint is our own file).

@@ -193,15 +193,15 @@ uint64_t RenderSession::light_paths_for(uint64_t samples) const {
 void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) {
   uint64_t want = light_paths_for(uint64_t(m_first_sample) + uint64_t(target));
   if (want <= m_lt_issued) return;
-  m_film.begin_light_paths();
+  if (!m_lt_partial) m_film.begin_light_paths();  // once a pass, as an uninterrupted pass does
   // Chunks of paths run on the threads in waves; each wave's splats are merged in path order before
   // the next, which bounds the memory they take whatever the pass's size.
   constexpr uint64_t kChunk = 1024, kWave = 64;
   const uint64_t first = m_lt_issued, count = want - first;
-  m_lt_issued = want;  // paths of a cancelled chunk are skipped, not retried: they stay independent
   const uint64_t chunks = (count + kChunk - 1) / kChunk;
   std::vector<std::vector<CausticSplat>> splats(size_t(std::min(chunks, kWave)));
   std::vector<uint8_t> finished(splats.size());
+  uint64_t merged = 0;  // chunks merged, in order: a cut keeps these and traces the rest on resume
   for (uint64_t wave = 0; wave < chunks && !stop_requested(cancel); wave += kWave) {
     const size_t in_wave = size_t(std::min(kWave, chunks - wave));
     for (auto& s : splats) s.clear();
@@ -223,12 +223,15 @@ void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) 
     for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
     worker();
     for (auto& t : pool) t.join();
-    for (size_t c = 0; c < in_wave; ++c) {
-      if (!finished[c]) continue;
+    size_t c = 0;
+    for (; c < in_wave && finished[c]; ++c, ++merged) {
       m_film.add_splats(splats[c]);
       m_film.add_light_paths(std::min(kChunk, count - (wave + c) * kChunk));
     }
+    if (c < in_wave) break;  // cut: the chunks after the first unfinished one are traced again
   }
+  m_lt_issued = first + std::min(count, merged * kChunk);
+  m_lt_partial = m_lt_issued < want;
 }
 
 bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel, const TileCallback& on_tile) {
@@ -307,7 +310,7 @@ void RenderSession::set_sample_range(uint32_t first, const std::vector<uint8_t>&
 }
 
 void RenderSession::save(BinaryWriter& out) const {
-  out.pod(m_first_sample), out.pod(m_lt_issued);
+  out.pod(m_first_sample), out.pod(m_lt_issued), out.pod(uint8_t(m_lt_partial));
   out.pod(m_samples.load()), out.pod(m_rays.load()), out.pod(m_nonfinite.load()), out.pod(m_cpu_ns.load());
   out.pod(m_seconds), out.pod(int32_t(m_passes));
   m_film.save(out);
@@ -316,6 +319,9 @@ void RenderSession::save(BinaryWriter& out) const {
 void RenderSession::restore(BinaryReader& in) {
   if (in.pod<uint32_t>() != m_first_sample) in.fail("another share of the samples");
   m_lt_issued = in.pod<uint64_t>();
+  const uint8_t partial = in.pod<uint8_t>();
+  if (partial > 1) in.fail("an impossible light-path state");
+  m_lt_partial = partial != 0;
   m_samples = in.pod<uint64_t>(), m_rays = in.pod<uint64_t>(), m_nonfinite = in.pod<uint64_t>();
   m_cpu_ns = in.pod<uint64_t>();
   m_seconds = in.pod<double>();

@@ -137,7 +137,10 @@ class RenderSession : public PassSource {
   std::vector<uint64_t> m_tile_ns;  // each tile's render time in the last pass that reached it
   std::vector<uint64_t> m_tile_samples;  // and the samples it took there
   CausticFilm m_caustic_film;
-  uint64_t m_lt_issued = 0;  // light paths issued (a cancelled chunk's are skipped, not retried)
+  // Light paths traced so far. A pass cut short keeps the chunks done in order and traces the rest
+  // when it resumes (m_lt_partial), so that a cancelled or checkpointed render ends on the same sums.
+  uint64_t m_lt_issued = 0;
+  bool m_lt_partial = false;
   std::atomic<uint64_t> m_samples{0}, m_rays{0}, m_nonfinite{0};
   std::atomic<uint64_t> m_budget_done{0};  // pixel-samples done, converged pixels counted in full
   std::atomic<uint64_t> m_cpu_ns{0};      // SessionStats::cpu_seconds

@@ -3,9 +3,12 @@
 // applies only where it can; images stay independent of the thread count.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <thread>
 
 #include "caustics.h"
 #include "collada.h"
@@ -158,6 +161,38 @@ TEST(Caustics, SameImageAtAnyThreadCount) {
   ASSERT_EQ(a.pixels.size(), b.pixels.size());
   for (size_t i = 0; i < a.pixels.size(); ++i) ASSERT_EQ(a.pixels[i], b.pixels[i]) << i;
   EXPECT_GT(one.stats().light_paths, 0u);
+}
+
+// A pass cut short anywhere (its light paths or its tiles) and then resumed ends on the
+// uninterrupted render's film, bit for bit: the light paths of a cut are traced again, not skipped,
+// and each pass opens the error estimate's light-path part once. Where each cut lands depends on
+// the timing; the result must not.
+TEST(Caustics, APassCutShortAndResumedEndsOnTheSameImage) {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  RenderParams p = cornell_params();
+  p.spp = 32;
+  auto scene = make_render_scene(desc, p);
+  RenderSession whole(*scene, p);
+  whole.render_all();
+  RenderSession cut(*scene, p);
+  int cuts = 0;
+  for (int target = 1; target <= p.spp; target *= 2)
+    for (int delay_us : {0, 200, 2000}) {  // cuts early in the light paths, later, in the tiles
+      std::atomic<bool> stop{delay_us == 0};
+      std::thread stopper([&] {
+        std::this_thread::sleep_for(std::chrono::microseconds(delay_us));
+        stop = true;
+      });
+      cuts += !cut.render_pass(target, &stop);
+      stopper.join();
+      ASSERT_TRUE(cut.render_pass(target));  // resumed to the pass's end
+    }
+  EXPECT_GT(cuts, 0);
+  EXPECT_EQ(cut.stats().light_paths, whole.stats().light_paths);
+  const ImageRGB a = whole.image(), b = cut.image();
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec3)), 0);
+  EXPECT_EQ(cut.error_estimate(), whole.error_estimate());
 }
 
 // The pool of light paths makes the splats that one path after another makes: the same splats in
