@@ -76,6 +76,7 @@ class GuardedStream final : public httplib::Stream {
     return m_pos < m_len || wait_ready(m_sock, POLLIN, after(seconds), m_svr_sock) == 1;
   }
   ReadFailure failure() const { return m_failure; }
+  void extend_deadline(double seconds) { m_deadline = std::max(m_deadline, after(seconds)); }
   int status() const { return m_status; }  // of the response to the current request; 0 before it starts
 
   bool is_readable() const override {
@@ -292,5 +293,9 @@ bool ends_connection(int status) {
 ReadFailure current_read_failure() { return t_stream ? t_stream->failure() : ReadFailure::none; }
 
 void close_after_response() { t_close = true; }
+
+void extend_request_deadline(double seconds) {
+  if (t_stream) t_stream->extend_deadline(seconds);
+}
 
 }  // namespace srv

@@ -75,5 +75,8 @@ bool ends_connection(int status);
 // Closes the current thread's connection once this response is sent (a request whose body was
 // never read must not have its body parsed as the next request).
 void close_after_response();
+// Gives the current request `seconds` from now to arrive whole: an upload of many megabytes needs
+// longer than --read-timeout; called before its body is read, once its size is known.
+void extend_request_deadline(double seconds);
 
 }  // namespace srv

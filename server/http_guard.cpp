@@ -77,6 +77,7 @@ int http_status(JobErrorKind kind) {
     case JobErrorKind::shutting_down: return 503;
     case JobErrorKind::no_storage: return 507;
     case JobErrorKind::scene_broken: return 422;
+    case JobErrorKind::read_only: return 403;
   }
   return 500;
 }
@@ -98,12 +99,28 @@ json parse_body(const httplib::Request& req) {
   }
 }
 
+namespace {
+
+std::function<size_t(const std::string&, const std::string&)> body_limit_of(const ApiOptions& o) {
+  return [max_body = o.max_body, max_scene = o.max_scene_bytes](const std::string& method, const std::string& path) {
+    return is_scene_upload(method, path) ? max_scene : max_body;
+  };
+}
+
+std::string too_large(size_t limit) {
+  return "the request body exceeds the limit of " +
+         (limit >= (size_t(1) << 20) ? std::to_string(limit >> 20) + " MiB" : std::to_string(limit / 1024) + " KiB");
+}
+
+}  // namespace
+
 void install_guards(httplib::Server& svr, const ApiOptions& options) {
-  svr.set_payload_max_length(options.max_body);
+  svr.set_payload_max_length(std::max(options.max_body, options.max_scene_bytes));
   // Runs after the head is read and before any body: the Host, the token, where the request comes
   // from, then the body's framing.
-  svr.set_pre_routing_handler([token = options.token, max_body = options.max_body, hosts = options.hosts](
-                                  const httplib::Request& req, httplib::Response& res) {
+  svr.set_pre_routing_handler([token = options.token, body_limit = body_limit_of(options), hosts = options.hosts,
+                               read_timeout = options.limits.request_timeout](const httplib::Request& req,
+                                                                             httplib::Response& res) {
     using Result = httplib::Server::HandlerResponse;
     // Methods whose body httplib reads (PRI: an HTTP/2 preface, read to the end of the connection).
     bool body_method = req.method == "POST" || req.method == "PUT" || req.method == "PATCH" || req.method == "PRI";
@@ -155,8 +172,17 @@ void install_guards(httplib::Server& svr, const ApiOptions& options) {
           len.find_first_not_of("0123456789") != std::string::npos)
         return refuse(400, "Content-Length must be one non-negative integer");
       // Refused before a byte of it is read (httplib would read and discard it all first).
-      if (std::stoull(len) > max_body)
-        return refuse(413, "the request body exceeds the limit of " + std::to_string(max_body / 1024) + " KiB");
+      const size_t max_body = body_limit(req.method, req.path);
+      if (std::stoull(len) > max_body) return refuse(413, too_large(max_body));
+      if (is_scene_upload(req.method, req.path)) {
+        // Refused before its megabytes are read (httplib would also parse a form body itself).
+        const std::string type = media_type(req.get_header_value("Content-Type"));
+        if (!is_scene_media_type(type))
+          return refuse(415, std::string("Content-Type must be the scene's own: ") + kSceneMediaTypes + " (got '" +
+                                 to_valid_utf8(clip_utf8(type, 100)) + "')");
+        // Its megabytes get time to arrive at 1 MiB/s or better, on top of --read-timeout.
+        extend_request_deadline(read_timeout + std::stoull(len) / 1048576.0);
+      }
     }
     if (!body_method) {
       // httplib never reads a GET's (or HEAD's, OPTIONS') body: close after answering rather than
@@ -178,13 +204,14 @@ void install_guards(httplib::Server& svr, const ApiOptions& options) {
 
   // Expect: 100-continue is answered before routing: a body over the limit gets its 413 instead of
   // an invitation to send it.
-  svr.set_expect_100_continue_handler([max_body = options.max_body](const httplib::Request& req,
-                                                                    httplib::Response& res) {
+  svr.set_expect_100_continue_handler([body_limit = body_limit_of(options)](const httplib::Request& req,
+                                                                           httplib::Response& res) {
     std::string len = req.get_header_value("Content-Length");
+    const size_t max_body = body_limit(req.method, req.path);
     bool digits = !len.empty() && len.size() <= 19 && len.find_first_not_of("0123456789") == std::string::npos;
     if (digits && std::stoull(len) <= max_body) return 100;
     if (!digits) send_error(res, 400, "Content-Length must be one non-negative integer");
-    else send_error(res, 413, "the request body exceeds the limit of " + std::to_string(max_body / 1024) + " KiB");
+    else send_error(res, 413, too_large(max_body));
     close_after_response();
     res.set_header("Connection", "close");
     return res.status;

@@ -19,11 +19,24 @@ struct ApiOptions {
   std::string token;        // when set, required on every /api call but /api/health
   ConnectionLimits limits;  // named in the 408 / 431 messages
   size_t max_body = 64 * 1024;  // request body bytes (413 beyond)
+  size_t max_scene_bytes = size_t(64) << 20;  // an uploaded scene's bytes (PUT /api/scenes/{name})
   HostPolicy hosts;         // which Host headers are answered (421 otherwise)
   // The methods a path answers ("" for none): a known path asked with another method gets 405 and
   // this in its Allow header. install_routes sets it from its route table.
   std::function<std::string(const std::string&)> allowed_methods;
 };
+
+// A scene upload, whose body may be as large as max_scene_bytes (other bodies: max_body).
+inline bool is_scene_upload(const std::string& method, const std::string& path) {
+  return method == "PUT" && path.rfind("/api/scenes/", 0) == 0;
+}
+// An upload's media type must be a scene's own: none a browser sends cross-site without asking.
+inline bool is_scene_media_type(const std::string& type) {
+  return type == "model/gltf-binary" || type == "model/gltf+json" || type == "model/vnd.collada+xml" ||
+         type == "application/octet-stream";
+}
+constexpr const char* kSceneMediaTypes =
+    "model/gltf-binary, model/gltf+json, model/vnd.collada+xml or application/octet-stream";
 
 void send_json(httplib::Response& res, int status, const json& body);
 void send_error(httplib::Response& res, int status, const std::string& message, const std::string& field = "");

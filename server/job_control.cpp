@@ -194,6 +194,19 @@ void JobManager::delete_files(const std::string& id) {
   if (::rmdir(dir.c_str()) != 0) std::fprintf(stderr, "render-server: cannot remove %s\n", dir.c_str());
 }
 
+void JobManager::delete_scene(const std::string& name) {
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    for (auto& kv : m_jobs) {
+      std::lock_guard<std::mutex> jl(kv.second->mutex);
+      if (kv.second->spec.scene == name && !is_final(kv.second->state))
+        throw JobError(JobErrorKind::conflict, "job " + kv.first + " (" + job_state_name(kv.second->state) +
+                       ") renders '" + name + "': cancel it first", "name");
+    }
+  }
+  m_scenes.remove_upload(name);
+}
+
 uint64_t JobManager::data_bytes() const {
   std::vector<std::string> ids;
   {
@@ -202,7 +215,7 @@ uint64_t JobManager::data_bytes() const {
   }
   uint64_t bytes = 0;
   for (const std::string& id : ids) bytes += folder_bytes(job_dir(id));
-  return bytes;
+  return bytes + folder_bytes(m_config.data_dir + "/scenes");
 }
 
 void JobManager::enforce_retention() {

@@ -29,6 +29,7 @@ enum class JobErrorKind {
   shutting_down,  // the server is stopping: retry later
   no_storage,     // the data folder cannot store the job
   scene_broken,   // the job's scene no longer loads
+  read_only,      // a bundled scene cannot be replaced or deleted
 };
 
 class JobError : public std::runtime_error {

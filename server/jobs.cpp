@@ -104,6 +104,8 @@ void JobManager::start() {
     throw std::runtime_error("data directory '" + m_config.data_dir + "' is not writable (" + e.what() + ")");
   }
   m_lock = std::make_unique<DataDirLock>(m_config.data_dir);
+  make_dirs(m_config.data_dir + "/scenes");  // uploaded scenes
+  m_scenes.set_upload_dir(m_config.data_dir + "/scenes");
   // A real write, not access(): root passes access() on a read-only mount or a full disk.
   try {
     std::string probe = m_config.data_dir + "/jobs/.write-probe";

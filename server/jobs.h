@@ -129,6 +129,8 @@ class JobManager {
   bool remove(const std::string& id);
   // The data folder's size in bytes (job files, checkpoints included).
   uint64_t data_bytes() const;
+  // Deletes an uploaded scene (SceneLibrary::remove_upload); conflict while a live job uses it.
+  void delete_scene(const std::string& name);
 
   json status_json(const Job& job, bool with_history = true) const;  // job.mutex must be held
   // Distance from the job's camera through pixel (x, y) (top-left origin) to the first surface;

@@ -39,6 +39,8 @@ const char* kUsage =
     "  --units-in-flight N  Redis: passes queued ahead of the merges per job (default 4; about\n"
     "                    the number of workers)\n"
     "  --redis-timeout SEC  Redis: seconds a job waits for an unreachable Redis, then fails (default 300)\n"
+    "  --max-scene-mb M  the largest scene PUT /api/scenes/{name} takes, in MiB (default 64).\n"
+    "                    Uploaded scenes are kept in DIR/scenes of --data\n"
     "  --checkpoint-interval SEC  seconds between a running job's checkpoints, which a restart, a\n"
     "                    pause or a continue resumes exactly (default 30; 0 = after every pass)\n"
     "  --keep-jobs N     keep the newest N finished jobs; older ones are deleted with their files\n"
@@ -156,6 +158,7 @@ int main(int argc, char** argv) {
       cfg.checkpoint_interval = std::strtod(v, &end);
       if (*v == '\0' || *end != '\0' || !(cfg.checkpoint_interval >= 0 && cfg.checkpoint_interval <= 86400)) bad(v);
     }
+    else if (a == "--max-scene-mb") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); api.max_scene_bytes = size_t(n) << 20; }
     else if (a == "--keep-jobs") { const char* v = value(); if (!parse_int(v, 0, 100000000, &n)) bad(v); cfg.keep_jobs = size_t(n); }
     else if (a == "--max-data-mb") { const char* v = value(); if (!parse_int(v, 0, 1L << 40, &n)) bad(v); cfg.max_data_bytes = uint64_t(n) << 20; }
     else if (a == "--token") api.token = value();

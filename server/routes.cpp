@@ -10,6 +10,7 @@
 #include <regex>
 
 #include "event_stream.h"
+#include "collada.h"
 #include "image.h"
 
 namespace srv {
@@ -53,6 +54,33 @@ void get_openapi(JobManager&, const ApiOptions& options, const Request&, Respons
 
 void list_scenes(JobManager& jobs, const ApiOptions&, const Request&, Response& res) {
   send_json(res, 200, {{"scenes", jobs.scenes().list()}, {"defaults", job_spec_defaults()}});
+}
+
+// PUT /api/scenes/{name}: the raw scene file, loaded before it is stored (201 new, 200 replaced;
+// 422 with the loader's message). The body's media type is the scene's own: a browser cannot send
+// those cross-site without asking first.
+void put_scene(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  const std::string type = media_type(req.get_header_value("Content-Type"));
+  if (!is_scene_media_type(type))  // http_guard refused it already; kept beside the route it guards
+    throw HttpError(415, std::string("Content-Type must be the scene's own: ") + kSceneMediaTypes);
+  const std::string name = req.matches[1];
+  try {
+    auto [summary, created] = jobs.scenes().store_upload(name, req.body);
+    std::fprintf(stderr, "render-server: scene '%s' uploaded (%zu bytes)\n", name.c_str(), req.body.size());
+    send_json(res, created ? 201 : 200, {{"name", name}, {"source", "uploaded"}, {"summary", summary}});
+  } catch (const pt::SceneError& e) {
+    throw JobError(JobErrorKind::scene_broken, to_valid_utf8(e.what()), "body");
+  }
+}
+
+void get_scene(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  send_json(res, 200, jobs.scenes().entry(req.matches[1]));
+}
+
+void delete_scene(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  const std::string name = req.matches[1];
+  jobs.delete_scene(name);
+  send_json(res, 200, {{"name", name}, {"state", "deleted"}});
 }
 
 // ---- jobs ----
@@ -203,6 +231,9 @@ const Route kRoutes[] = {
     {"GET", "/api/health", get_health},
     {"GET", "/api/openapi\\.json", get_openapi},
     {"GET", "/api/scenes", list_scenes},
+    {"GET", "/api/scenes/([^/]+)", get_scene},
+    {"PUT", "/api/scenes/([^/]+)", put_scene},
+    {"DELETE", "/api/scenes/([^/]+)", delete_scene},
     {"POST", "/api/jobs/check", check_job},
     {"POST", "/api/jobs", submit_job},
     {"GET", "/api/jobs", list_jobs},
@@ -227,7 +258,7 @@ std::string allowed_methods(const std::string& path) {
   // A literal path ("/api/jobs/check") names its own methods, not those of a pattern it also fits.
   auto methods = [&](bool literal) {
     std::string allow;
-    for (const char* m : {"GET", "POST", "DELETE"})
+    for (const char* m : {"GET", "POST", "PUT", "DELETE"})
       for (size_t i = 0; i < patterns.size(); ++i)
         if (kRoutes[i].method == std::string(m) && (std::strchr(kRoutes[i].path, '(') == nullptr) == literal &&
             std::regex_match(path, patterns[i])) {
@@ -252,6 +283,7 @@ void install_routes(httplib::Server& svr, JobManager& jobs, const ApiOptions& op
     std::string method = r.method;
     if (method == "GET") svr.Get(r.path, run);
     else if (method == "POST") svr.Post(r.path, run);
+    else if (method == "PUT") svr.Put(r.path, run);
     else if (method == "DELETE") svr.Delete(r.path, run);
   }
 }

@@ -9,6 +9,7 @@
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -25,7 +26,9 @@ std::string canonical(const std::string& path) {
   return realpath(path.c_str(), buf) ? std::string(buf) : std::string();
 }
 
-json summarize(const pt::SceneDesc& d) {
+}  // namespace
+
+json summarize_desc(const pt::SceneDesc& d) {
   std::set<std::string> mats, lights;
   for (const pt::MeshDesc& m : d.meshes)
     for (int t : m.tri_material) mats.insert(pt::material_type_name(d.materials[t].type));
@@ -42,8 +45,6 @@ json summarize(const pt::SceneDesc& d) {
               {"center_distance", focus}};
 }
 
-}  // namespace
-
 SceneLibrary::SceneLibrary(std::vector<std::string> dirs, size_t cache_bytes) : m_cache_bytes(cache_bytes) {
   for (const std::string& d : dirs) {
     std::string c = canonical(d);
@@ -53,15 +54,30 @@ SceneLibrary::SceneLibrary(std::vector<std::string> dirs, size_t cache_bytes) : 
 
 std::string SceneLibrary::resolve(const std::string& name) const {
   if (!valid_scene_name(name)) return "";
-  for (const std::string& dir : m_dirs) {
-    std::string real = canonical(dir + "/" + name + ".dae");
-    // The real file must lie inside the directory: a symlink pointing out is refused.
-    if (!real.empty() && real.compare(0, dir.size() + 1, dir + "/") == 0) {
-      struct stat st;
-      if (stat(real.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return real;
+  std::vector<std::string> dirs = m_dirs;
+  if (!m_upload_dir.empty()) dirs.push_back(m_upload_dir);
+  for (const std::string& dir : dirs)
+    for (const char* ext : kSceneExtensions) {
+      std::string real = canonical(dir + "/" + name + ext);
+      // The real file must lie inside the directory: a symlink pointing out is refused.
+      if (!real.empty() && real.compare(0, dir.size() + 1, dir + "/") == 0) {
+        struct stat st;
+        if (stat(real.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return real;
+      }
     }
-  }
   return "";
+}
+
+std::string SceneLibrary::file_name(const std::string& name) const {
+  const std::string path = resolve(name);
+  const size_t dot = path.rfind('.');
+  return name + (dot == std::string::npos ? std::string(".dae") : path.substr(dot));
+}
+
+pt::SceneDesc parse_scene_bytes(const std::string& bytes, const std::string& file_name) {
+  if (file_name.size() > 4 && file_name.compare(file_name.size() - 4, 4, ".dae") == 0)
+    return pt::parse_collada(bytes, file_name);
+  throw pt::SceneError(file_name + ": glTF scenes are not read yet (COLLADA .dae only)");
 }
 
 std::string SceneLibrary::read_scene(const std::string& name, uint64_t* hash) const {
@@ -70,7 +86,7 @@ std::string SceneLibrary::read_scene(const std::string& name, uint64_t* hash) co
   // Checked before reading: the whole file is held in memory while it parses.
   struct stat st;
   if (stat(path.c_str(), &st) == 0 && size_t(st.st_size) > pt::LoadLimits().max_file_bytes)
-    throw pt::SceneError(name + ".dae: " + std::to_string(st.st_size) + " bytes, over the limit of " +
+    throw pt::SceneError(file_name(name) + ": " + std::to_string(st.st_size) + " bytes, over the limit of " +
                          std::to_string(pt::LoadLimits().max_file_bytes));
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
@@ -145,9 +161,9 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
   json summary;
   try {
     auto t0 = std::chrono::steady_clock::now();
-    pt::SceneDesc desc = pt::parse_collada(bytes, name + ".dae");
+    pt::SceneDesc desc = parse_scene_bytes(bytes, file_name(name));
     std::string().swap(bytes);
-    summary = summarize(desc);
+    summary = summarize_desc(desc);
     base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(desc));
     desc = pt::SceneDesc();  // from here on only the base holds the scene
     double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -177,33 +193,40 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
 
 json SceneLibrary::list() {
   std::set<std::string> names;
-  for (const std::string& dir : m_dirs) {
+  std::vector<std::string> dirs = m_dirs;
+  if (!m_upload_dir.empty()) dirs.push_back(m_upload_dir);
+  for (const std::string& dir : dirs) {
     DIR* d = opendir(dir.c_str());
     if (!d) continue;
     while (dirent* e = readdir(d)) {
       std::string f = e->d_name;
-      if (f.size() > 4 && f.compare(f.size() - 4, 4, ".dae") == 0) {
-        std::string name = f.substr(0, f.size() - 4);
-        if (valid_scene_name(name)) names.insert(name);
+      for (const char* ext : kSceneExtensions) {
+        const size_t n = std::strlen(ext);
+        if (f.size() > n && f.compare(f.size() - n, n, ext) == 0 && valid_scene_name(f.substr(0, f.size() - n)))
+          names.insert(f.substr(0, f.size() - n));
       }
     }
     closedir(d);
   }
   json out = json::array();
-  for (const std::string& name : names) {
-    json item{{"name", name}};
-    FileSummary cached = file_summary(name);
-    if (!cached.error.empty()) {
-      item["error"] = cached.error;
-    } else {
-      item["summary"] = cached.summary;
-      std::lock_guard<std::mutex> lock(m_mutex);
-      auto it = m_cache.find(cached.hash);
-      if (it != m_cache.end() && it->second.bytes > 0) item["memory_bytes"] = it->second.bytes;
-    }
-    out.push_back(item);
-  }
+  for (const std::string& name : names)
+    if (!resolve(name).empty()) out.push_back(entry(name));  // a link out of the folder is no scene
   return out;
+}
+
+json SceneLibrary::entry(const std::string& name) {
+  if (resolve(name).empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "name");
+  json item{{"name", name}, {"source", is_uploaded(name) ? "uploaded" : "bundled"}};
+  FileSummary cached = file_summary(name);
+  if (!cached.error.empty()) {
+    item["error"] = cached.error;
+  } else {
+    item["summary"] = cached.summary;
+    std::lock_guard<std::mutex> lock(m_mutex);
+    auto it = m_cache.find(cached.hash);
+    if (it != m_cache.end() && it->second.bytes > 0) item["memory_bytes"] = it->second.bytes;
+  }
+  return item;
 }
 
 SceneLibrary::FileSummary SceneLibrary::file_summary(const std::string& name) {
@@ -251,7 +274,7 @@ json SceneLibrary::summary(const std::string& name, uint64_t* content_hash) {
     forget_unused();
   }
   if (summary.is_null()) {  // parsed for its summary only: the base is built by the first job
-    summary = summarize(pt::parse_collada(bytes, name + ".dae"));
+    summary = summarize_desc(parse_scene_bytes(bytes, file_name(name)));
     std::lock_guard<std::mutex> lock(m_mutex);
     if (m_last_hash[name] == hash) m_cache[hash].summary = summary;
   }

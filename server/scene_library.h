@@ -18,12 +18,32 @@
 
 namespace srv {
 
+// The scene files the server reads, by extension, in the order a name is looked up.
+inline constexpr const char* kSceneExtensions[] = {".dae", ".glb", ".gltf"};
+// Parses a scene file's bytes by its name's extension; throws pt::SceneError naming `file_name`.
+pt::SceneDesc parse_scene_bytes(const std::string& bytes, const std::string& file_name);
+// What GET /api/scenes says of a scene: counts, materials, lights, the course camera's focus distance.
+json summarize_desc(const pt::SceneDesc& desc);
+
 class SceneLibrary {
  public:
   static constexpr size_t kDefaultCacheBytes = size_t(1) << 30;
   explicit SceneLibrary(std::vector<std::string> dirs, size_t cache_bytes = kDefaultCacheBytes);
   // The file for a scene name, or "" when no configured directory holds it.
   std::string resolve(const std::string& name) const;
+
+  // ---- uploaded scenes (scene_upload.cpp) ----
+  // Where PUT /api/scenes/{name} stores scenes (an existing folder, in the data folder). Uploaded
+  // scenes can be replaced and deleted; bundled ones (--scenes) cannot.
+  void set_upload_dir(const std::string& dir);
+  bool is_uploaded(const std::string& name) const;
+  // Loads `bytes` (COLLADA, or glTF once the loader reads it) and, when it loads, stores it as
+  // scene `name`, atomically. Returns the summary and whether the name is new. Throws
+  // pt::SceneError with the loader's message for a file that does not load, JobError(read_only)
+  // for a bundled scene's name, JobError(invalid) for a bad name.
+  std::pair<json, bool> store_upload(const std::string& name, const std::string& bytes);
+  // Deletes an uploaded scene; JobError(read_only) for a bundled one, JobError(not_found).
+  void remove_upload(const std::string& name);
   // The scene's shared render base (a job makes its view with pt::make_view), built at most once
   // per file content however many jobs ask at the same time. Throws JobError(not_found) for an unknown
   // name, pt::SceneError for a bad file.
@@ -35,6 +55,8 @@ class SceneLibrary {
   // Every scene with its summary, or its load error, and the bytes of its built base while the
   // cache holds one.
   json list();
+  // One scene as list() shows it; JobError(not_found) for an unknown name.
+  json entry(const std::string& name);
   // Throws JobError(not_found) for an unknown name, JobError(scene_broken) naming the loader's
   // message for a file that does not load (parsed once per file version).
   void check(const std::string& name);
@@ -75,7 +97,11 @@ class SceneLibrary {
   // The cached summary or error of a scene file's current version.
   FileSummary file_summary(const std::string& name);
 
-  std::vector<std::string> m_dirs;  // canonical
+  // The scene file's name as messages show it ("cornell.dae"), from its resolved path.
+  std::string file_name(const std::string& name) const;
+
+  std::vector<std::string> m_dirs;  // canonical; the bundled folders
+  std::string m_upload_dir;         // canonical; "" when uploads are off
   std::map<std::string, FileSummary> m_file_summaries;  // by scene name
   size_t m_cache_bytes;
   std::mutex m_mutex;

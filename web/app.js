@@ -433,6 +433,7 @@ function init() {
     }
   });
   initJobs();
+  initUpload();
   let resizeTimer = null;
   window.addEventListener('resize', () => {
     clearTimeout(resizeTimer);

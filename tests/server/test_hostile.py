@@ -303,7 +303,7 @@ NOT_FOUND = [
     ("GET", f"/api/jobs/{UNKNOWN}/events"), ("GET", f"/api/jobs/{UNKNOWN}/focus?x=1&y=1"),
     ("GET", "/api/jobs/check"),  # a job id that is not one
     ("GET", "/api/nope"), ("GET", "/api/%FF"), ("GET", "/api/"), ("POST", "/api/nope"),
-    ("GET", f"/api/jobs/{UNKNOWN}/image.gif"), ("GET", f"/api/jobs/{UNKNOWN}/nope"), ("GET", "/api/scenes/cornell"),
+    ("GET", f"/api/jobs/{UNKNOWN}/image.gif"), ("GET", f"/api/jobs/{UNKNOWN}/nope"),
 ]
 
 

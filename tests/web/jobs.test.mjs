@@ -1,12 +1,12 @@
 // The page's job list and what it does to jobs, in a real browser against a real render-server
 // (harness.mjs): the columns that tell a focus stack's jobs apart, pause and resume, a cancelled
 // job's downloads, delete, render more, a job's link or a reload putting its settings in the form,
-// and paging. Every wait is on a state the page or the server shows, never on the clock.
+// paging, and uploading a scene. Every wait is on a state the page or the server shows, never on the clock.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
-import { artifacts, startServer, stopServer, makeDataDir, openBrowser, waitReady, apiClient, pageSteps, assertFitsWidth } from './harness.mjs';
+import { artifacts, sourceDir, startServer, stopServer, makeDataDir, openBrowser, waitReady, apiClient, pageSteps, assertFitsWidth } from './harness.mjs';
 
 let dataDir, server, baseUrl, browser, page, api, defaults;
 let fill, submit, waitViewerEnded;
@@ -202,6 +202,24 @@ test('the list shows the newest 100 jobs and more on request', async () => {
   await assertFitsWidth(page, assert);
   await page.screenshot({ path: path.join(artifacts, 'web-jobs-narrow.png') });
   await page.setViewportSize({ width: 1280, height: 900 });
+});
+
+test('a scene uploaded with the file picker is summarised, selected and renders; a broken one shows the loader', async () => {
+  const cornell = fs.readFileSync(path.join(sourceDir, 'scenes', 'cornell.dae'));
+  await page.setInputFiles('#f-upload', { name: 'My Room.dae', mimeType: 'model/vnd.collada+xml', buffer: cornell });
+  await page.waitForFunction(() => /Scene 'My-Room' uploaded/.test(document.querySelector('#upload-status').textContent));
+  assert.equal(await page.inputValue('#f-scene'), 'My-Room');
+  assert.match(await page.textContent('#scene-summary'), /triangles/);
+  const listed = (await api.json('/api/scenes')).scenes.find((sc) => sc.name === 'My-Room');
+  assert.equal(listed.source, 'uploaded');
+  const id = await submit({ scene: 'My-Room', spp: 2, width: 32, height: 24 });
+  await waitViewerEnded('done');
+  assert.equal((await api.json(`/api/jobs/${id}`)).spec.scene, 'My-Room');
+  const broken = Buffer.from(cornell.toString().replace('</COLLADA>', ''));
+  await page.setInputFiles('#f-upload', { name: 'broken.dae', mimeType: 'model/vnd.collada+xml', buffer: broken });
+  await page.waitForFunction(() => document.querySelector('#upload-status').dataset.kind === 'error');
+  assert.match(await page.textContent('#upload-status'), /^broken\.dae: broken\.dae/);
+  assert.ok(!(await api.json('/api/scenes')).scenes.some((sc) => sc.name === 'broken'), 'a broken scene was stored');
 });
 
 test('no uncaught errors on the page', () => {
