@@ -45,6 +45,7 @@ struct GeomInfo {
   const uint32_t* indices = nullptr;  // Embree-owned index buffer
   std::vector<float> normals;         // shading normals, 3 floats a vertex and 1 of padding; empty for flat meshes
   std::vector<TriangleInfo> tris;     // per triangle
+  std::vector<float> attributes;      // u v r g b a vertex; empty for meshes without uvs and colours
   const float* spheres = nullptr;     // x y z r per sphere
   std::vector<float> sphere_data;     // what `spheres` points to (Embree user geometry reads it)
   std::vector<int> sphere_material;
@@ -185,7 +186,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
       Vec3 p0 = pos[tri[0]], p1 = pos[tri[1]], p2 = pos[tri[2]];
       info.tris[t] = {normalize(cross(p1 - p0, p2 - p0)), tri_material[t], tri_light.empty() ? -1 : tri_light[t]};
     }
-    a.bytes += info.normals.size() * sizeof(float) + info.tris.size() * sizeof(TriangleInfo);
+    a.bytes += (info.normals.size() + info.attributes.size()) * sizeof(float) + info.tris.size() * sizeof(TriangleInfo);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a.scene, g);
     rtcReleaseGeometry(g);
@@ -204,6 +205,14 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
       info.normals.reserve(3 * mesh.normals.size() + 1);
       for (Vec3 n : mesh.normals) info.normals.insert(info.normals.end(), {n.x, n.y, n.z});
       info.normals.push_back(0.0f);
+    }
+    if (!mesh.uvs.empty() || !mesh.colors.empty()) {  // absent ones read as uv (0, 0), colour white
+      info.attributes.reserve(5 * mesh.positions.size());
+      for (size_t v = 0; v < mesh.positions.size(); ++v) {
+        Vec2 uv = v < mesh.uvs.size() ? mesh.uvs[v] : Vec2{};
+        Vec3 c = v < mesh.colors.size() ? mesh.colors[v] : Vec3(1.0f);
+        info.attributes.insert(info.attributes.end(), {uv.x, uv.y, c.x, c.y, c.z});
+      }
     }
     static const std::vector<int> none;
     add_triangles(mesh.positions, mesh.indices, mesh.tri_material, m < mesh_light.size() ? mesh_light[m] : none,
@@ -254,7 +263,8 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     a.geoms[id] = std::move(info);
   }
   for (GeomInfo& g : a.geoms)  // the vectors' buffers are where they stay
-    g.triangles = {g.positions, g.indices, g.normals.empty() ? nullptr : g.normals.data(), g.tris.data()};
+    g.triangles = {g.positions, g.indices, g.normals.empty() ? nullptr : g.normals.data(), g.tris.data(),
+                   g.attributes.empty() ? nullptr : g.attributes.data()};
 
   rtcCommitScene(a.scene);
   a.check("building the BVH");

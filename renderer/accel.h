@@ -29,6 +29,10 @@ struct SurfaceHit {
   int material = -1;
   int light = -1;    // >= 0 when the surface is an emitter registered as a light
   float offset = 0;  // how far to push spawned rays off the surface (scale-aware)
+  // Interpolated texture coordinates and vertex colour: written only for meshes that carry them
+  // (MeshDesc::uvs / colors), read only for textured materials (Material::textured).
+  Vec2 uv;
+  Vec3 color;
 };
 
 class Accel {

@@ -175,7 +175,18 @@ struct TriangleData {
   const uint32_t* indices;
   const float* normals;  // shading normals, or null for a flat mesh
   const TriangleInfo* tris;
+  const float* attributes;  // u v r g b a vertex, or null for a mesh without uvs and colours
 };
+
+// The texture coordinates and vertex colour at barycentrics (u, v), for meshes that have them.
+inline void interpolate_attributes(const TriangleData& m, const uint32_t* tri, float u, float v, SurfaceHit& hit) {
+  const float* a0 = m.attributes + 5 * size_t(tri[0]);
+  const float* a1 = m.attributes + 5 * size_t(tri[1]);
+  const float* a2 = m.attributes + 5 * size_t(tri[2]);
+  const float w = 1 - u - v;
+  hit.uv = Vec2{a0[0] * w + a1[0] * u + a2[0] * v, a0[1] * w + a1[1] * u + a2[1] * v};
+  hit.color = Vec3(a0[2] * w + a1[2] * u + a2[2] * v, a0[3] * w + a1[3] * u + a2[3] * v, a0[4] * w + a1[4] * u + a2[4] * v);
+}
 
 // The hit record of a hit on triangle `prim` at t with barycentrics (u, v): the point from the
 // barycentrics (not o + t d, which drifts off the plane), the unit face normal (for a degenerate
@@ -203,6 +214,7 @@ inline void refine_triangle_scalar(const TriangleData& m, unsigned prim, float t
   hit.material = info.material;
   hit.light = info.light;
   hit.offset = 0;
+  if (m.attributes) interpolate_attributes(m, tri, u, v, hit);
 }
 
 // The hit record of a hit on sphere s (centre x y z, radius) at t: the point re-projected onto the
@@ -283,6 +295,7 @@ template <class EmbreeNormal>
   sse::store_vectors(hit, p, ng, ns);
   std::memcpy(&hit.material, &info.material, 2 * sizeof(int));  // material and light, adjacent in both
   hit.offset = 0;
+  if (m.attributes) interpolate_attributes(m, tri, u, v, hit);
 #else
   refine_triangle_scalar(m, prim, t, u, v, eng, hit);
 #endif

@@ -184,7 +184,12 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
     return false;
   }
 
-  const Material& material = scene.materials[hit.material];
+  const Material* file_material = &scene.materials[hit.material];
+  if constexpr ((F & kFeatTexture) != 0) {
+    thread_local Material scratch;  // a textured material's BSDF at this hit, used within this call
+    file_material = &material_at(scene, *file_material, hit, scratch);
+  }
+  const Material& material = *file_material;
   Vec3 wo_world = -st.ray.d;
   if (material.type == MaterialType::emission) {
     Vec3 le = emitted_radiance(material, Vec3(0, 0, dot(wo_world, hit.ng)));
@@ -302,6 +307,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
   u.resize(size_t(n));
   samplers.resize(size_t(n));
   for (int j = 0; j < n; ++j) samplers[size_t(j)] = &rngs[slots[which[j]].job];
+  const bool textures = (scene.features.bits & kFeatTexture) != 0;
   // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
   // for all vertices at once: each sampler still sees its own draws in that order.
   for (size_t l = 0; l < nl; ++l)  // light sample l of every vertex: u_light[l n, (l + 1) n)
@@ -312,7 +318,8 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
     const uint32_t i = which[j < n ? j : 0];  // padding lanes repeat the first vertex
     PathState& st = slots[i].st;
     const SurfaceHit& h = hits[i];
-    const Vec3 albedo = scene.materials[h.material].albedo;
+    const Material& m = scene.materials[h.material];
+    const Vec3 albedo = textures && m.textured() ? albedo_at(scene, m, h) : m.albedo;
     v.px[j] = h.p.x, v.py[j] = h.p.y, v.pz[j] = h.p.z;
     v.gx[j] = h.ng.x, v.gy[j] = h.ng.y, v.gz[j] = h.ng.z;
     v.nx[j] = h.ns.x, v.ny[j] = h.ns.y, v.nz[j] = h.ns.z;
@@ -486,8 +493,10 @@ Vec3 trace_path(const RenderScene& scene, const PathSettings& settings, Ray ray,
 PathBatchTracer path_batch_tracer_for(uint32_t bits, const PathSettings& settings) {
   if (settings.hemisphere) return nullptr;  // -H casts its direct-light rays one at a time
   static const PathBatchTracer table[] = {
-      trace_paths_t<0>, trace_paths_t<1>, trace_paths_t<2>, trace_paths_t<3>,
-      trace_paths_t<4>, trace_paths_t<5>, trace_paths_t<6>, trace_paths_t<7>,
+      trace_paths_t<0>,  trace_paths_t<1>,  trace_paths_t<2>,  trace_paths_t<3>,
+      trace_paths_t<4>,  trace_paths_t<5>,  trace_paths_t<6>,  trace_paths_t<7>,
+      trace_paths_t<8>,  trace_paths_t<9>,  trace_paths_t<10>, trace_paths_t<11>,
+      trace_paths_t<12>, trace_paths_t<13>, trace_paths_t<14>, trace_paths_t<15>,
   };
   static_assert(sizeof(table) / sizeof(table[0]) == kFeatAll + 1, "one instantiation per feature combination");
   return table[bits & kFeatAll];
@@ -495,8 +504,10 @@ PathBatchTracer path_batch_tracer_for(uint32_t bits, const PathSettings& setting
 
 PathTracer path_tracer_for(uint32_t bits) {
   static const PathTracer table[] = {
-      trace_path_t<0>, trace_path_t<1>, trace_path_t<2>, trace_path_t<3>,
-      trace_path_t<4>, trace_path_t<5>, trace_path_t<6>, trace_path_t<7>,
+      trace_path_t<0>,  trace_path_t<1>,  trace_path_t<2>,  trace_path_t<3>,
+      trace_path_t<4>,  trace_path_t<5>,  trace_path_t<6>,  trace_path_t<7>,
+      trace_path_t<8>,  trace_path_t<9>,  trace_path_t<10>, trace_path_t<11>,
+      trace_path_t<12>, trace_path_t<13>, trace_path_t<14>, trace_path_t<15>,
   };
   static_assert(sizeof(table) / sizeof(table[0]) == kFeatAll + 1, "one instantiation per feature combination");
   return table[bits & kFeatAll];

@@ -15,6 +15,7 @@
 #include "lights.h"
 #include "options.h"
 #include "scene.h"
+#include "texture.h"
 
 namespace pt {
 
@@ -23,7 +24,8 @@ enum FeatureBits : uint32_t {
   kFeatDelta = 1,        // mirror, glass or refraction materials
   kFeatMicrofacet = 2,   // microfacet materials
   kFeatInfinite = 4,     // ambient or environment lights (escaping rays look them up)
-  kFeatAll = 7,
+  kFeatTexture = 8,      // textured materials (texture or vertex colours: Material::textured)
+  kFeatAll = 15,
 };
 
 struct SceneFeatures {
@@ -31,6 +33,7 @@ struct SceneFeatures {
   bool spheres = false, meshes = false, environment = false, thin_lens = false;
   bool adaptive = false, shading_normals = false;
   bool caustic_tracing = false;  // caustics by light tracing (caustics.h)
+  size_t textures = 0;           // textures the materials read per hit
   uint32_t bits = kFeatAll;  // which specialised path loop runs
 };
 
@@ -40,6 +43,8 @@ struct SceneFeatures {
 struct SceneBase {
   std::vector<Material> materials;  // the file's, then one emission material per area-light panel
   std::vector<Light> lights;        // without the environment map (that is a render option)
+  std::shared_ptr<const std::vector<TextureDesc>> textures;  // what textured materials read
+  bool default_light = false;       // SceneDesc::default_light: a view may add the white environment
   std::shared_ptr<const Accel> accel;
   SceneFeatures features;           // what the file contains; a view adds the options' features
   size_t triangle_count = 0, sphere_count = 0;
@@ -67,6 +72,7 @@ struct RenderScene {
   std::vector<int> infinite_lights;  // ambient / environment, looked up when rays escape
   int environment_light = -1;        // visible to camera rays
   std::shared_ptr<const EnvironmentMap> environment;
+  std::shared_ptr<const std::vector<TextureDesc>> textures;  // shared with the SceneBase
   std::shared_ptr<const Accel> accel;  // shared with the SceneBase and its other views
   Camera camera;
   SceneFeatures features;
@@ -77,6 +83,24 @@ struct RenderScene {
   std::vector<int> caustic_lights;
   Distribution1D caustic_light_distribution;
 };
+
+// A textured material's albedo at a hit: its albedo times its texture at the hit's uv and the
+// hit's vertex colour (Material::texture, vertex_color).
+inline Vec3 albedo_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
+  Vec3 a = m.albedo;
+  if (m.texture >= 0) a = a * eval_texture((*scene.textures)[size_t(m.texture)], hit.uv);
+  if (m.vertex_color) a = a * hit.color;
+  return a;
+}
+
+// The material a path sees at a hit: `m` itself, or for a textured material a diffuse one with
+// the albedo there (textured materials are diffuse: make_scene_base checks).
+inline const Material& material_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit, Material& scratch) {
+  if (!m.textured()) return m;
+  scratch.type = MaterialType::diffuse;
+  scratch.albedo = albedo_at(scene, m, hit);
+  return scratch;
+}
 
 // Builds what the integrator needs from the file's description: lights (area lights also as
 // visible panels, emissive meshes as mesh lights), the environment map, the camera, the BVH.
