@@ -9,12 +9,13 @@
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
 
 #include "camera.h"
-#include "collada.h"
+#include "scene_file.h"
 
 namespace srv {
 
@@ -54,11 +55,13 @@ SceneLibrary::SceneLibrary(std::vector<std::string> dirs, size_t cache_bytes) : 
 std::string SceneLibrary::resolve(const std::string& name) const {
   if (!valid_scene_name(name)) return "";
   for (const std::string& dir : m_dirs) {
-    std::string real = canonical(dir + "/" + name + ".dae");
-    // The real file must lie inside the directory: a symlink pointing out is refused.
-    if (!real.empty() && real.compare(0, dir.size() + 1, dir + "/") == 0) {
-      struct stat st;
-      if (stat(real.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return real;
+    for (const char* ext : pt::kSceneExtensions) {  // name.dae, then name.gltf, then name.glb
+      std::string real = canonical(dir + "/" + name + ext);
+      // The real file must lie inside the directory: a symlink pointing out is refused.
+      if (!real.empty() && real.compare(0, dir.size() + 1, dir + "/") == 0) {
+        struct stat st;
+        if (stat(real.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return real;
+      }
     }
   }
   return "";
@@ -70,7 +73,7 @@ std::string SceneLibrary::read_scene(const std::string& name, uint64_t* hash) co
   // Checked before reading: the whole file is held in memory while it parses.
   struct stat st;
   if (stat(path.c_str(), &st) == 0 && size_t(st.st_size) > pt::LoadLimits().max_file_bytes)
-    throw pt::SceneError(name + ".dae: " + std::to_string(st.st_size) + " bytes, over the limit of " +
+    throw pt::SceneError(path.substr(path.find_last_of('/') + 1) + ": " + std::to_string(st.st_size) + " bytes, over the limit of " +
                          std::to_string(pt::LoadLimits().max_file_bytes));
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
@@ -145,7 +148,7 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
   json summary;
   try {
     auto t0 = std::chrono::steady_clock::now();
-    pt::SceneDesc desc = pt::parse_collada(bytes, name + ".dae");
+    pt::SceneDesc desc = pt::parse_scene(bytes, pt::scene_file_name(name, bytes));
     std::string().swap(bytes);
     summary = summarize(desc);
     base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(desc));
@@ -182,9 +185,12 @@ json SceneLibrary::list() {
     if (!d) continue;
     while (dirent* e = readdir(d)) {
       std::string f = e->d_name;
-      if (f.size() > 4 && f.compare(f.size() - 4, 4, ".dae") == 0) {
-        std::string name = f.substr(0, f.size() - 4);
-        if (valid_scene_name(name)) names.insert(name);
+      for (const char* ext : pt::kSceneExtensions) {
+        const size_t n = std::strlen(ext);
+        if (f.size() > n && f.compare(f.size() - n, n, ext) == 0) {
+          std::string name = f.substr(0, f.size() - n);
+          if (valid_scene_name(name)) names.insert(name);
+        }
       }
     }
     closedir(d);
@@ -246,7 +252,7 @@ json SceneLibrary::summary(const std::string& name, uint64_t* content_hash) {
     forget_unused();
   }
   if (summary.is_null()) {  // parsed for its summary only: the base is built by the first job
-    summary = summarize(pt::parse_collada(bytes, name + ".dae"));
+    summary = summarize(pt::parse_scene(bytes, pt::scene_file_name(name, bytes)));
     std::lock_guard<std::mutex> lock(m_mutex);
     if (m_last_hash[name] == hash) m_cache[hash].summary = summary;
   }
