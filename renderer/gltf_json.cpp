@@ -7,7 +7,9 @@
 
 #include <sys/stat.h>
 
+#include <climits>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "gltf_check.h"
@@ -95,10 +97,15 @@ void Checker::check_uri(const json& o, const std::string& path, int64_t byte_len
   if (file.empty()) fail(at, "'" + clip(printable(uri)) + "' is not a file in the scene's folder (a relative path without '..')");
   if (m_ctx.base_dir.empty())
     fail(at, "refers to the file '" + clip(printable(file)) + "'; only self-contained glTF is read here (.glb, or data: URIs)");
+  // Symbolic links may not lead out of the folder either (tinygltf's reads check it again).
+  char folder[PATH_MAX], real[PATH_MAX];
+  const std::string full = m_ctx.base_dir + "/" + file;
+  const bool found = realpath(m_ctx.base_dir.c_str(), folder) && realpath(full.c_str(), real);
+  if (found && std::string(real).compare(0, std::strlen(folder) + 1, std::string(folder) + "/") != 0)
+    fail(at, "'" + clip(printable(file)) + "' leads out of the scene's folder");
   if (image) return;  // missing images fail where a material reads them
   struct stat st {};
-  std::string full = m_ctx.base_dir + "/" + file;
-  if (stat(full.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) fail(at, "cannot read '" + clip(printable(file)) + "'");
+  if (!found || stat(real, &st) != 0 || !S_ISREG(st.st_mode)) fail(at, "cannot read '" + clip(printable(file)) + "'");
   if (int64_t(st.st_size) != byte_length)
     fail(at, "'" + clip(printable(file)) + "' is " + std::to_string(st.st_size) + " bytes, byteLength says " +
                  std::to_string(byte_length));
