@@ -145,6 +145,7 @@ struct Accel::Impl {
   // takes a packet of 16 apart through its stream path, and native packets of 8 cost about 2% fewer
   // instructions per pass on AVX2 (docs/performance.md).
   int packet_width = 16;
+  bool attributes = false;  // some mesh has uvs or colours: hits interpolate them
 
   void check(const char* what) {
     std::lock_guard<std::mutex> lock(error.mutex);
@@ -262,6 +263,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     if (a.geoms.size() <= id) a.geoms.resize(id + 1);
     a.geoms[id] = std::move(info);
   }
+  for (const GeomInfo& g : a.geoms) a.attributes |= !g.attributes.empty();
   for (GeomInfo& g : a.geoms)  // the vectors' buffers are where they stay
     g.triangles = {g.positions, g.indices, g.normals.empty() ? nullptr : g.normals.data(), g.tris.data(),
                    g.attributes.empty() ? nullptr : g.attributes.data()};
@@ -317,11 +319,12 @@ inline void to_embree(const Ray& r, RTCRay& e) {
 // geometric normal, read only for a degenerate triangle. Inlined into the packet loop: as a call,
 // its eight arguments and prologue cost 1.2% of CBbunny's instructions (docs/performance.md,
 // "Design choices that pay").
-template <class EmbreeNormal>
+// `Attributes`: the scene has meshes with uvs or colours; without, not even their check runs.
+template <bool Attributes, class EmbreeNormal>
 [[gnu::always_inline]] inline void refine_hit(const GeomInfo& g, const Ray& ray, unsigned prim, float t, float u,
                                               float v, EmbreeNormal&& eng, SurfaceHit& hit) {
   if (g.kind == GeomKind::spheres) refine_sphere(g.spheres + 4 * size_t(prim), g.sphere_material[prim], ray, t, hit);
-  else refine_triangle(g.triangles, prim, t, u, v, eng, hit);
+  else refine_triangle<Attributes>(g.triangles, prim, t, u, v, eng, hit);
 }
 
 // Embree's packet types and calls for packets of K rays.
@@ -386,7 +389,7 @@ struct Lanes {
   }
 };
 
-template <int K>
+template <int K, bool Attributes>
 void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
@@ -401,7 +404,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
       const uint32_t i = lanes.ray[k];
       if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
       found[i] = 1;
-      refine_hit(a.geoms[rh.hit.geomID[k]], at[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
+      refine_hit<Attributes>(a.geoms[rh.hit.geomID[k]], at[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
                  [&] { return Vec3(rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]); }, hits[i]);
     }
     lanes.used = 0;
@@ -452,8 +455,10 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(m_impl->scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  refine_hit(a.geoms[rh.hit.geomID], ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v,
-             [&] { return Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z); }, hit);
+  auto eng = [&] { return Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z); };
+  const GeomInfo& g = a.geoms[rh.hit.geomID];
+  if (a.attributes) refine_hit<true>(g, ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v, eng, hit);
+  else refine_hit<false>(g, ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v, eng, hit);
   return true;
 }
 
@@ -468,8 +473,14 @@ bool Accel::occluded(const Ray& ray) const {
 }
 
 void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const {
-  if (m_impl->packet_width == 16) intersect_packets<16>(*m_impl, rays, stride, n, hits, found);
-  else intersect_packets<8>(*m_impl, rays, stride, n, hits, found);
+  const Impl& a = *m_impl;
+  if (a.packet_width == 16) {
+    if (a.attributes) intersect_packets<16, true>(a, rays, stride, n, hits, found);
+    else intersect_packets<16, false>(a, rays, stride, n, hits, found);
+  } else {
+    if (a.attributes) intersect_packets<8, true>(a, rays, stride, n, hits, found);
+    else intersect_packets<8, false>(a, rays, stride, n, hits, found);
+  }
 }
 
 void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {

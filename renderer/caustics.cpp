@@ -197,9 +197,7 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
                      bool found, const SurfaceHit& hit, Connect&& connect) {
   const int vertex = lp.vertex++;
   if (!found) return false;
-  const Material& file_material = scene.materials[hit.material];
-  thread_local Material scratch;  // a textured material's BSDF at this hit, used within this call
-  const Material& m = file_material.textured() ? material_at(scene, file_material, hit, scratch) : file_material;
+  const Material& m = material_at(scene, scene.materials[hit.material], hit);  // used within this call
   if (m.type == MaterialType::emission) return false;  // emitters reflect nothing
   const bool delta = is_delta(m);
   // Ours are L S+ D+ E: a first non-delta vertex ends a path with no delta bounce, and a delta

@@ -185,10 +185,7 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
   }
 
   const Material* file_material = &scene.materials[hit.material];
-  if constexpr ((F & kFeatTexture) != 0) {
-    thread_local Material scratch;  // a textured material's BSDF at this hit, used within this call
-    file_material = &material_at(scene, *file_material, hit, scratch);
-  }
+  if constexpr ((F & kFeatTexture) != 0) file_material = &material_at(scene, *file_material, hit);  // used within this call
   const Material& material = *file_material;
   Vec3 wo_world = -st.ray.d;
   if (material.type == MaterialType::emission) {
@@ -307,7 +304,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
   u.resize(size_t(n));
   samplers.resize(size_t(n));
   for (int j = 0; j < n; ++j) samplers[size_t(j)] = &rngs[slots[which[j]].job];
-  const bool textures = (scene.features.bits & kFeatTexture) != 0;
+  const bool textures = scene.features.textured;
   // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
   // for all vertices at once: each sampler still sees its own draws in that order.
   for (size_t l = 0; l < nl; ++l)  // light sample l of every vertex: u_light[l n, (l + 1) n)
@@ -490,27 +487,27 @@ Vec3 trace_path(const RenderScene& scene, const PathSettings& settings, Ray ray,
   return trace_path_t<kFeatAll>(scene, settings, ray, rng, rays);
 }
 
+// Textured scenes take the generic loop rather than eight more instantiations of each loop (build
+// time, code size); they pay its run-time checks of the material kinds they lack.
 PathBatchTracer path_batch_tracer_for(uint32_t bits, const PathSettings& settings) {
   if (settings.hemisphere) return nullptr;  // -H casts its direct-light rays one at a time
+  if (bits & kFeatTexture) return trace_paths_t<kFeatAll>;
   static const PathBatchTracer table[] = {
-      trace_paths_t<0>,  trace_paths_t<1>,  trace_paths_t<2>,  trace_paths_t<3>,
-      trace_paths_t<4>,  trace_paths_t<5>,  trace_paths_t<6>,  trace_paths_t<7>,
-      trace_paths_t<8>,  trace_paths_t<9>,  trace_paths_t<10>, trace_paths_t<11>,
-      trace_paths_t<12>, trace_paths_t<13>, trace_paths_t<14>, trace_paths_t<15>,
+      trace_paths_t<0>, trace_paths_t<1>, trace_paths_t<2>, trace_paths_t<3>,
+      trace_paths_t<4>, trace_paths_t<5>, trace_paths_t<6>, trace_paths_t<7>,
   };
-  static_assert(sizeof(table) / sizeof(table[0]) == kFeatAll + 1, "one instantiation per feature combination");
-  return table[bits & kFeatAll];
+  static_assert(sizeof(table) / sizeof(table[0]) == kFeatTexture, "one instantiation per untextured feature combination");
+  return table[bits & (kFeatTexture - 1)];
 }
 
 PathTracer path_tracer_for(uint32_t bits) {
+  if (bits & kFeatTexture) return trace_path_t<kFeatAll>;
   static const PathTracer table[] = {
-      trace_path_t<0>,  trace_path_t<1>,  trace_path_t<2>,  trace_path_t<3>,
-      trace_path_t<4>,  trace_path_t<5>,  trace_path_t<6>,  trace_path_t<7>,
-      trace_path_t<8>,  trace_path_t<9>,  trace_path_t<10>, trace_path_t<11>,
-      trace_path_t<12>, trace_path_t<13>, trace_path_t<14>, trace_path_t<15>,
+      trace_path_t<0>, trace_path_t<1>, trace_path_t<2>, trace_path_t<3>,
+      trace_path_t<4>, trace_path_t<5>, trace_path_t<6>, trace_path_t<7>,
   };
-  static_assert(sizeof(table) / sizeof(table[0]) == kFeatAll + 1, "one instantiation per feature combination");
-  return table[bits & kFeatAll];
+  static_assert(sizeof(table) / sizeof(table[0]) == kFeatTexture, "one instantiation per untextured feature combination");
+  return table[bits & (kFeatTexture - 1)];
 }
 
 }  // namespace pt

@@ -184,7 +184,9 @@ SceneBase make_scene_base(const SceneDesc& desc) {
       throw std::runtime_error(desc.source + ": sphere '" + s.name + "' has a textured material");
   if (f.bits & kFeatTexture) {
     base.textures = std::make_shared<const std::vector<TextureDesc>>(desc.textures);
+    f.textured = true;
     f.textures = desc.textures.size();
+    f.bits = kFeatAll;  // textured scenes take the generic loop (path_tracer_for)
   }
   base.default_light = desc.default_light;
   base.triangle_count = desc.triangle_count();
@@ -301,6 +303,13 @@ std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams
 std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
   params.validate();  // before the build: a bad option fails fast
   return view_of(make_scene_base(desc), params);
+}
+
+[[gnu::noinline]] const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
+  thread_local Material scratch;
+  scratch.type = MaterialType::diffuse;
+  scratch.albedo = albedo_at(scene, m, hit);
+  return scratch;
 }
 
 float autofocus_distance(const RenderScene& scene, float sx, float sy) {

@@ -24,7 +24,7 @@ enum FeatureBits : uint32_t {
   kFeatDelta = 1,        // mirror, glass or refraction materials
   kFeatMicrofacet = 2,   // microfacet materials
   kFeatInfinite = 4,     // ambient or environment lights (escaping rays look them up)
-  kFeatTexture = 8,      // textured materials (texture or vertex colours: Material::textured)
+  kFeatTexture = 8,      // textured materials (texture or vertex colours): such scenes take the generic loop
   kFeatAll = 15,
 };
 
@@ -33,6 +33,7 @@ struct SceneFeatures {
   bool spheres = false, meshes = false, environment = false, thin_lens = false;
   bool adaptive = false, shading_normals = false;
   bool caustic_tracing = false;  // caustics by light tracing (caustics.h)
+  bool textured = false;         // textured materials (textures or vertex colours)
   size_t textures = 0;           // textures the materials read per hit
   uint32_t bits = kFeatAll;  // which specialised path loop runs
 };
@@ -89,17 +90,18 @@ struct RenderScene {
 inline Vec3 albedo_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
   Vec3 a = m.albedo;
   if (m.texture >= 0) a = a * eval_texture((*scene.textures)[size_t(m.texture)], hit.uv);
-  if (m.vertex_color) a = a * hit.color;
+  if (m.vertex_color) a = a * Vec3(srgb8_to_linear(hit.color[0]), srgb8_to_linear(hit.color[1]), srgb8_to_linear(hit.color[2]));
   return a;
 }
 
-// The material a path sees at a hit: `m` itself, or for a textured material a diffuse one with
-// the albedo there (textured materials are diffuse: make_scene_base checks).
-inline const Material& material_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit, Material& scratch) {
-  if (!m.textured()) return m;
-  scratch.type = MaterialType::diffuse;
-  scratch.albedo = albedo_at(scene, m, hit);
-  return scratch;
+// A textured material at a hit: a diffuse material with the albedo there, held per thread until
+// the thread's next call (textured materials are diffuse: make_scene_base checks). Out of line, so
+// that the loops that may meet one stay as small as without textures.
+const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit);
+
+// The material a path sees at a hit: `m`, or textured_material for a textured one.
+inline const Material& material_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
+  return __builtin_expect(m.textured(), 0) ? textured_material(scene, m, hit) : m;
 }
 
 // Builds what the integrator needs from the file's description: lights (area lights also as

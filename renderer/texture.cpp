@@ -48,6 +48,13 @@ inline Vec3 texel(const TextureDesc& t, int x, int y) {
 
 float srgb8_to_linear(uint8_t code) { return srgb_table()[code]; }
 
+uint8_t linear_to_srgb8(float v) {
+  if (!(v > 0)) return 0;
+  if (v >= 1) return 255;
+  double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(double(v), 1 / 2.4) - 0.055;
+  return uint8_t(std::lround(255 * s));
+}
+
 Vec3 eval_texture(const TextureDesc& t, Vec2 uv) {
   if (t.width <= 0 || t.height <= 0 || t.texels.size() < 3 * size_t(t.width) * size_t(t.height)) return Vec3(1.0f);
   // Far-out or non-finite coordinates would overflow the texel index: read them at 0.

@@ -108,9 +108,12 @@ TEST(GltfRender, TexturesAndVertexColoursShowTheirColours) {
   v.doc["cameras"] = g.doc["cameras"];
   v.root(json{{"camera", 0}, {"translation", {0, 0, 3}}});
   ImageRGB vc = render(parse_gltf(v.text(), "coloured.gltf", false), p);
-  const float want[3] = {0.4f, 0.2f, 0.8f};
+  // 0.8 x (0.5, 0.25, 1), the colour as a hit carries it: 8-bit sRGB (as precise as a texture).
+  const float colour[3] = {0.5f, 0.25f, 1.0f};
   for (int c = 0; c < 3; ++c) {
     RegionStats s = region_stats(vc, half - 8, half - 8, half + 8, half + 8, c);
-    EXPECT_NEAR(s.mean, want[c], 4.5 * s.stderr_ + 1e-3) << "channel " << c;
+    const double want = 0.8 * srgb8_to_linear(linear_to_srgb8(colour[c]));
+    EXPECT_NEAR(want, 0.8 * colour[c], 0.01 * 0.8 * colour[c]);  // within 1%
+    EXPECT_NEAR(s.mean, want, 4.5 * s.stderr_ + 1e-4) << "channel " << c;
   }
 }

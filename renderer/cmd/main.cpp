@@ -50,14 +50,13 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
   if (!f.caustic_tracing && caustic_tracing_applies(scene, deeper))
     caustics += " (-s 2 -m 2 or more would light-trace them)";
   std::printf("caustics:         %s\n", caustics.c_str());
-  std::printf("textures:         %s\n", (f.bits & kFeatTexture) == 0 ? "no"
+  std::printf("textures:         %s\n", !f.textured ? "no"
                                       : f.textures ? (std::to_string(f.textures) + " (and vertex colours where meshes have them)").c_str()
                                                    : "vertex colours");
-  std::printf("path loop:        %s%s%s%s%s\n", f.bits == kFeatAll ? "generic" : "specialised:",
+  std::printf("path loop:        %s%s%s%s\n", f.bits == kFeatAll ? (f.textured ? "generic (textures)" : "generic") : "specialised:",
               f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),
-              f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"),
-              f.bits == kFeatAll ? "" : ((f.bits & kFeatTexture) ? " textures" : " no-textures"));
+              f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
   const bool packets = packets_apply(scene, o.params);
   if (packets) std::printf("ray queries:      paths in Embree packets of %d\n", scene.accel->packet_width());
   else std::printf("ray queries:      one path at a time\n");
