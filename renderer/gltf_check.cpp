@@ -15,12 +15,12 @@ void Checker::materials() {
       numbers(*pbr, "baseColorFactor", at, 4, 0, 1);
       number(*pbr, "metallicFactor", at, false, 0, 1);
       number(*pbr, "roughnessFactor", at, false, 0, 1);
-      texture_info(*pbr, "baseColorTexture", at);
-      texture_info(*pbr, "metallicRoughnessTexture", at);
+      texture_info(*pbr, "baseColorTexture", at, true);
+      texture_info(*pbr, "metallicRoughnessTexture", at, true);
     }
     texture_info(m, "normalTexture", path);
     texture_info(m, "occlusionTexture", path);
-    texture_info(m, "emissiveTexture", path);
+    texture_info(m, "emissiveTexture", path, true);
     numbers(m, "emissiveFactor", path, 3, 0, 1);
     string(m, "alphaMode", path);
     number(m, "alphaCutoff", path, false, 0, HUGE_VAL);
@@ -246,7 +246,7 @@ Checked check_json(const Context& ctx, const Parts& parts) {
   json doc;
   try {
     doc = json::parse(parts.json.begin(), parts.json.end(), limit);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // a syntax error, or a number too large for a double
     std::string what = e.what();
     size_t bracket = what.find("] ");
     throw SceneError(ctx.name + ": JSON error: " + printable(bracket == std::string::npos ? what : what.substr(bracket + 2)));

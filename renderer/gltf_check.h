@@ -121,8 +121,9 @@ class Checker {
   void boolean(const json& o, const char* key, const std::string& path) const {
     if (o.contains(key) && !o[key].is_boolean()) fail(path + "/" + key, "must be true or false");
   }
-  // A textureInfo: `index` into textures, `texCoord` a set number.
-  void texture_info(const json& o, const char* key, const std::string& path) {
+  // A textureInfo: `index` into textures, `texCoord` a set number. With `read`, its image is one
+  // the materials read (decoded; the others never are).
+  void texture_info(const json& o, const char* key, const std::string& path, bool read = false) {
     const json* t = object(o, key, path);
     if (!t) return;
     const std::string at = path + "/" + key;
@@ -131,7 +132,7 @@ class Checker {
     number(*t, "scale", at, false, -1e9, 1e9, 1);
     number(*t, "strength", at, false, 0, 1, 1);
     const json& texture = m_doc["textures"][size_t(tex)];
-    if (texture.contains("source")) m_checked.decode_image[size_t(texture["source"].get<int64_t>())] = true;
+    if (read && texture.contains("source")) m_checked.decode_image[size_t(texture["source"].get<int64_t>())] = true;
   }
   void check_uri(const json& o, const std::string& path, int64_t byte_length, bool image);
   void asset_and_extensions();

@@ -122,6 +122,10 @@ Material MaterialMaker::make(int index, bool vertex_color, const std::string& pa
   if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty())
     m_ctx.warn("alphaMode", at + "/alphaMode", "alphaMode " + clip(g.alphaMode) + " is not supported: surfaces render opaque");
   if (g.normalTexture.index >= 0) m_ctx.warn("normalTexture", at + "/normalTexture", "normal maps are ignored");
+  auto transmission_ext = g.extensions.find("KHR_materials_transmission");
+  if (transmission_ext != g.extensions.end() && transmission_ext->second.Has("transmissionTexture"))
+    m_ctx.warn("transmissionTexture", at + "/extensions/KHR_materials_transmission/transmissionTexture",
+               "transmission textures are ignored: the factor decides");
   if (g.occlusionTexture.index >= 0)
     m_ctx.warn("occlusionTexture", at + "/occlusionTexture", "occlusion textures are ignored (the path tracer finds occlusion)");
 

@@ -45,6 +45,7 @@ void write_file(const std::string& path, const std::string& bytes) {
 TEST(GltfErrors, BadJsonAndMissingParts) {
   EXPECT_TRUE(fails_at(R"({"asset": {"version": "2.0"},)", "JSON error: "));
   EXPECT_TRUE(fails_at("[1, 2]", "/: the JSON root must be an object"));
+  EXPECT_TRUE(fails_at(R"({"asset": {"version": "2.0"}, "x": 41e308})", "JSON error: "));  // beyond a double (fuzzer)
   EXPECT_TRUE(fails_at("{}", "/: missing 'asset'"));
   EXPECT_TRUE(fails_at(R"({"asset": {"version": "1.0"}})", "/asset/version: '1.0' is not glTF 2.x"));
   GltfDoc g = test::quad_doc();

@@ -196,7 +196,19 @@ std::vector<uint8_t> decode_rgb8(const uint8_t* data, size_t size, size_t max_pi
   if (size >= 8 && std::memcmp(data, png, 8) == 0) name = "texture.png";
   else if (size >= 3 && std::memcmp(data, jpeg, 3) == 0) name = "texture.jpg";
   else throw std::runtime_error("not a PNG or JPEG image");
-  OIIO::Filesystem::IOMemReader reader(const_cast<uint8_t*>(data), size);
+  // A PNG's chunks must all be there up to IEND: OpenImageIO 2.4's read callback reports a short
+  // read by a longjmp through libpng that skips its own C++ destructors (a leak the fuzzer found).
+  if (name[8] == 'p') {
+    size_t at = 8;
+    for (;;) {
+      if (size - at < 12) throw std::runtime_error("the PNG is cut short");
+      const size_t len = size_t(data[at]) << 24 | size_t(data[at + 1]) << 16 | size_t(data[at + 2]) << 8 | data[at + 3];
+      if (len > size - at - 12) throw std::runtime_error("the PNG is cut short");
+      if (std::memcmp(data + at + 4, "IEND", 4) == 0) break;
+      at += 12 + len;
+    }
+  }
+  OIIO::Filesystem::IOMemReader reader(data, size);
   auto in = OIIO::ImageInput::open(name, nullptr, &reader);
   if (!in) throw std::runtime_error("cannot decode the image: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
