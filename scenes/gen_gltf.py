@@ -304,7 +304,7 @@ def write_showcase(out):
     g.node("gold sphere", mesh=g.mesh("gold sphere", pos, idx, gold, normals=nrm), translation=[0.9, 0.5, -0.6])
     panel = g.material("emissive panel", (0, 0, 0), emissive=(6.0, 5.4, 4.8))
     g.node("panel", mesh=g.mesh("panel", [(-0.6, 0, -0.3), (0.6, 0, -0.3), (0.6, 0, 0.3), (-0.6, 0, 0.3)],
-                                [0, 2, 1, 0, 3, 2], panel), translation=[0, 2.6, 0])
+                                [0, 1, 2, 0, 2, 3], panel), translation=[0, 2.6, 0])  # facing down
     # A spot light of 15,000 cd (about 22 W/sr in our units) aimed at the origin from (2.5, 3.5, 2.5).
     g.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
         {"name": "spot", "type": "spot", "color": [1.0, 0.95, 0.85], "intensity": 15000.0,
