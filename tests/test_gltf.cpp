@@ -76,6 +76,11 @@ TEST(Gltf, OurShowcaseMapsEachMaterialLightAndTheCamera) {
   EXPECT_EQ(find_material(d, "glass")->type, MaterialType::glass);
   EXPECT_NEAR(find_material(d, "glass")->transmittance.x, 0.95f, 1e-6f);
   EXPECT_NEAR(find_material(d, "emissive panel")->radiance.y, 5.4f, 1e-5f);
+  for (const MeshDesc& m : d.meshes)  // the panel's front (emitting) face looks down on the scene
+    if (m.name == "panel") {
+      const uint32_t* i = m.indices.data();
+      EXPECT_LT(cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]).y, 0.0f);
+    }
   ASSERT_EQ(d.lights.size(), 1u);
   const LightDesc& spot = d.lights[0];
   EXPECT_EQ(spot.type, LightType::spot);
