@@ -45,6 +45,7 @@ struct GeomInfo {
   const uint32_t* indices = nullptr;  // Embree-owned index buffer
   std::vector<float> normals;         // shading normals, 3 floats a vertex and 1 of padding; empty for flat meshes
   std::vector<TriangleInfo> tris;     // per triangle
+  std::vector<float> attributes;      // u v r g b a vertex; empty for meshes without uvs and colours
   const float* spheres = nullptr;     // x y z r per sphere
   std::vector<float> sphere_data;     // what `spheres` points to (Embree user geometry reads it)
   std::vector<int> sphere_material;
@@ -144,6 +145,7 @@ struct Accel::Impl {
   // takes a packet of 16 apart through its stream path, and native packets of 8 cost about 2% fewer
   // instructions per pass on AVX2 (docs/performance.md).
   int packet_width = 16;
+  bool attributes = false;  // some mesh has uvs or colours: hits interpolate them
 
   void check(const char* what) {
     std::lock_guard<std::mutex> lock(error.mutex);
@@ -185,7 +187,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
       Vec3 p0 = pos[tri[0]], p1 = pos[tri[1]], p2 = pos[tri[2]];
       info.tris[t] = {normalize(cross(p1 - p0, p2 - p0)), tri_material[t], tri_light.empty() ? -1 : tri_light[t]};
     }
-    a.bytes += info.normals.size() * sizeof(float) + info.tris.size() * sizeof(TriangleInfo);
+    a.bytes += (info.normals.size() + info.attributes.size()) * sizeof(float) + info.tris.size() * sizeof(TriangleInfo);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a.scene, g);
     rtcReleaseGeometry(g);
@@ -204,6 +206,14 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
       info.normals.reserve(3 * mesh.normals.size() + 1);
       for (Vec3 n : mesh.normals) info.normals.insert(info.normals.end(), {n.x, n.y, n.z});
       info.normals.push_back(0.0f);
+    }
+    if (!mesh.uvs.empty() || !mesh.colors.empty()) {  // absent ones read as uv (0, 0), colour white
+      info.attributes.reserve(5 * mesh.positions.size());
+      for (size_t v = 0; v < mesh.positions.size(); ++v) {
+        Vec2 uv = v < mesh.uvs.size() ? mesh.uvs[v] : Vec2{};
+        Vec3 c = v < mesh.colors.size() ? mesh.colors[v] : Vec3(1.0f);
+        info.attributes.insert(info.attributes.end(), {uv.x, uv.y, c.x, c.y, c.z});
+      }
     }
     static const std::vector<int> none;
     add_triangles(mesh.positions, mesh.indices, mesh.tri_material, m < mesh_light.size() ? mesh_light[m] : none,
@@ -253,8 +263,10 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     if (a.geoms.size() <= id) a.geoms.resize(id + 1);
     a.geoms[id] = std::move(info);
   }
+  for (const GeomInfo& g : a.geoms) a.attributes |= !g.attributes.empty();
   for (GeomInfo& g : a.geoms)  // the vectors' buffers are where they stay
-    g.triangles = {g.positions, g.indices, g.normals.empty() ? nullptr : g.normals.data(), g.tris.data()};
+    g.triangles = {g.positions, g.indices, g.normals.empty() ? nullptr : g.normals.data(), g.tris.data(),
+                   g.attributes.empty() ? nullptr : g.attributes.data()};
 
   rtcCommitScene(a.scene);
   a.check("building the BVH");
@@ -307,11 +319,12 @@ inline void to_embree(const Ray& r, RTCRay& e) {
 // geometric normal, read only for a degenerate triangle. Inlined into the packet loop: as a call,
 // its eight arguments and prologue cost 1.2% of CBbunny's instructions (docs/performance.md,
 // "Design choices that pay").
-template <class EmbreeNormal>
+// `Attributes`: the scene has meshes with uvs or colours; without, not even their check runs.
+template <bool Attributes, class EmbreeNormal>
 [[gnu::always_inline]] inline void refine_hit(const GeomInfo& g, const Ray& ray, unsigned prim, float t, float u,
                                               float v, EmbreeNormal&& eng, SurfaceHit& hit) {
   if (g.kind == GeomKind::spheres) refine_sphere(g.spheres + 4 * size_t(prim), g.sphere_material[prim], ray, t, hit);
-  else refine_triangle(g.triangles, prim, t, u, v, eng, hit);
+  else refine_triangle<Attributes>(g.triangles, prim, t, u, v, eng, hit);
 }
 
 // Embree's packet types and calls for packets of K rays.
@@ -376,7 +389,7 @@ struct Lanes {
   }
 };
 
-template <int K>
+template <int K, bool Attributes>
 void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
@@ -391,7 +404,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
       const uint32_t i = lanes.ray[k];
       if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
       found[i] = 1;
-      refine_hit(a.geoms[rh.hit.geomID[k]], at[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
+      refine_hit<Attributes>(a.geoms[rh.hit.geomID[k]], at[i], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k],
                  [&] { return Vec3(rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]); }, hits[i]);
     }
     lanes.used = 0;
@@ -442,8 +455,10 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(m_impl->scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  refine_hit(a.geoms[rh.hit.geomID], ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v,
-             [&] { return Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z); }, hit);
+  auto eng = [&] { return Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z); };
+  const GeomInfo& g = a.geoms[rh.hit.geomID];
+  if (a.attributes) refine_hit<true>(g, ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v, eng, hit);
+  else refine_hit<false>(g, ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v, eng, hit);
   return true;
 }
 
@@ -458,8 +473,14 @@ bool Accel::occluded(const Ray& ray) const {
 }
 
 void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const {
-  if (m_impl->packet_width == 16) intersect_packets<16>(*m_impl, rays, stride, n, hits, found);
-  else intersect_packets<8>(*m_impl, rays, stride, n, hits, found);
+  const Impl& a = *m_impl;
+  if (a.packet_width == 16) {
+    if (a.attributes) intersect_packets<16, true>(a, rays, stride, n, hits, found);
+    else intersect_packets<16, false>(a, rays, stride, n, hits, found);
+  } else {
+    if (a.attributes) intersect_packets<8, true>(a, rays, stride, n, hits, found);
+    else intersect_packets<8, false>(a, rays, stride, n, hits, found);
+  }
 }
 
 void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {

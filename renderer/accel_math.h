@@ -15,6 +15,7 @@
 
 #include "accel.h"
 #include "math.h"
+#include "texture.h"
 
 namespace pt {
 
@@ -175,12 +176,24 @@ struct TriangleData {
   const uint32_t* indices;
   const float* normals;  // shading normals, or null for a flat mesh
   const TriangleInfo* tris;
+  const float* attributes;  // u v r g b a vertex, or null for a mesh without uvs and colours
 };
+
+// The texture coordinates and vertex colour at barycentrics (u, v), for meshes that have them.
+inline void interpolate_attributes(const TriangleData& m, const uint32_t* tri, float u, float v, SurfaceHit& hit) {
+  const float* a0 = m.attributes + 5 * size_t(tri[0]);
+  const float* a1 = m.attributes + 5 * size_t(tri[1]);
+  const float* a2 = m.attributes + 5 * size_t(tri[2]);
+  const float w = 1 - u - v;
+  hit.uv = Vec2{a0[0] * w + a1[0] * u + a2[0] * v, a0[1] * w + a1[1] * u + a2[1] * v};
+  for (int c = 0; c < 3; ++c) hit.color[c] = linear_to_srgb8(a0[2 + c] * w + a1[2 + c] * u + a2[2 + c] * v);
+}
 
 // The hit record of a hit on triangle `prim` at t with barycentrics (u, v): the point from the
 // barycentrics (not o + t d, which drifts off the plane), the unit face normal (for a degenerate
 // triangle, from `eng()`: Embree's unnormalised one), the interpolated shading normal, material, light.
-template <class EmbreeNormal>
+// `Attributes`: the scene has meshes with uvs or colours (false skips even the check).
+template <bool Attributes = true, class EmbreeNormal>
 inline void refine_triangle_scalar(const TriangleData& m, unsigned prim, float t, float u, float v, EmbreeNormal&& eng,
                                    SurfaceHit& hit) {
   const uint32_t* tri = m.indices + 3 * size_t(prim);
@@ -203,6 +216,7 @@ inline void refine_triangle_scalar(const TriangleData& m, unsigned prim, float t
   hit.material = info.material;
   hit.light = info.light;
   hit.offset = 0;
+  if (Attributes && m.attributes) interpolate_attributes(m, tri, u, v, hit);
 }
 
 // The hit record of a hit on sphere s (centre x y z, radius) at t: the point re-projected onto the
@@ -260,7 +274,7 @@ static_assert(offsetof(SurfaceHit, ng) == offsetof(SurfaceHit, p) + 12 &&
 
 // refine_triangle_scalar's record with SSE: its bits, in about half the instructions (the hit
 // loop's refinement was a tenth of a mesh scene's pass; docs/performance.md, "Design choices that pay").
-template <class EmbreeNormal>
+template <bool Attributes = true, class EmbreeNormal>
 [[gnu::always_inline]] inline void refine_triangle(const TriangleData& m, unsigned prim, float t, float u, float v,
                                                    EmbreeNormal&& eng, SurfaceHit& hit) {
 #if defined(__SSE2__)
@@ -283,8 +297,9 @@ template <class EmbreeNormal>
   sse::store_vectors(hit, p, ng, ns);
   std::memcpy(&hit.material, &info.material, 2 * sizeof(int));  // material and light, adjacent in both
   hit.offset = 0;
+  if (Attributes && m.attributes) interpolate_attributes(m, tri, u, v, hit);
 #else
-  refine_triangle_scalar(m, prim, t, u, v, eng, hit);
+  refine_triangle_scalar<Attributes>(m, prim, t, u, v, eng, hit);
 #endif
 }
 

@@ -93,7 +93,7 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
 
   if (!p.settings_file.empty()) {
     read_settings_file(c, p.settings_file);
-  } else if (p.file_camera && authored.present) {
+  } else if ((p.file_camera || authored.as_authored) && authored.present) {
     const Mat4& m = authored.world;
     c.position = m.point(Vec3(0, 0, 0));
     Vec3 r = m.vector(Vec3(1, 0, 0)), u = m.vector(Vec3(0, 1, 0));
@@ -101,8 +101,10 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
     if (dot(cross(u, m.vector(Vec3(0, 0, 1))), r) < 0) c.right = -c.right;  // keep handedness as authored
     float h_fov, v_fov;
     file_fov(authored, &h_fov, &v_fov);
-    // Authored horizontal FOV spans the output width; the vertical follows the output aspect.
-    c.screen_distance = float(p.width) / (2 * std::tan(h_fov / 2));
+    // Authored horizontal FOV spans the output width; the vertical follows the output aspect. A
+    // glTF camera keeps its vertical FOV instead (its aspect ratio is the viewport's: glTF 2.0, 5.12).
+    if (authored.as_authored && authored.yfov_deg > 0) c.screen_distance = float(p.height) / (2 * std::tan(v_fov / 2));
+    else c.screen_distance = float(p.width) / (2 * std::tan(h_fov / 2));
     c.tmin = authored.znear;
     c.tmax = authored.zfar;
     c.target = c.position - c.back;
@@ -131,7 +133,8 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
   }
   // Resizing keeps the angle of a pixel: the FOV follows the output size (course behaviour).
   // keep_fov instead scales the course's 800-pixel-wide view to the output width.
-  if (p.keep_fov && p.settings_file.empty() && !p.file_camera) c.screen_distance *= float(p.width) / 800.0f;
+  if (p.keep_fov && p.settings_file.empty() && !p.file_camera && !(authored.as_authored && authored.present))
+    c.screen_distance *= float(p.width) / 800.0f;
   c.tan_half_w = (0.5f * p.width) / c.screen_distance;
   c.tan_half_h = (0.5f * p.height) / c.screen_distance;
   return c;

@@ -197,7 +197,7 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
                      bool found, const SurfaceHit& hit, Connect&& connect) {
   const int vertex = lp.vertex++;
   if (!found) return false;
-  const Material& m = scene.materials[hit.material];
+  const Material& m = material_at(scene, scene.materials[hit.material], hit);  // used within this call
   if (m.type == MaterialType::emission) return false;  // emitters reflect nothing
   const bool delta = is_delta(m);
   // Ours are L S+ D+ E: a first non-delta vertex ends a path with no delta bounce, and a delta

@@ -184,7 +184,9 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
     return false;
   }
 
-  const Material& material = scene.materials[hit.material];
+  const Material* file_material = &scene.materials[hit.material];
+  if constexpr ((F & kFeatTexture) != 0) file_material = &material_at(scene, *file_material, hit);  // used within this call
+  const Material& material = *file_material;
   Vec3 wo_world = -st.ray.d;
   if (material.type == MaterialType::emission) {
     Vec3 le = emitted_radiance(material, Vec3(0, 0, dot(wo_world, hit.ng)));
@@ -302,6 +304,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
   u.resize(size_t(n));
   samplers.resize(size_t(n));
   for (int j = 0; j < n; ++j) samplers[size_t(j)] = &rngs[slots[which[j]].job];
+  const bool textures = scene.features.textured;
   // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
   // for all vertices at once: each sampler still sees its own draws in that order.
   for (size_t l = 0; l < nl; ++l)  // light sample l of every vertex: u_light[l n, (l + 1) n)
@@ -312,7 +315,8 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
     const uint32_t i = which[j < n ? j : 0];  // padding lanes repeat the first vertex
     PathState& st = slots[i].st;
     const SurfaceHit& h = hits[i];
-    const Vec3 albedo = scene.materials[h.material].albedo;
+    const Material& m = scene.materials[h.material];
+    const Vec3 albedo = textures && m.textured() ? albedo_at(scene, m, h) : m.albedo;
     v.px[j] = h.p.x, v.py[j] = h.p.y, v.pz[j] = h.p.z;
     v.gx[j] = h.ng.x, v.gy[j] = h.ng.y, v.gz[j] = h.ng.z;
     v.nx[j] = h.ns.x, v.ny[j] = h.ns.y, v.nz[j] = h.ns.z;
@@ -483,23 +487,27 @@ Vec3 trace_path(const RenderScene& scene, const PathSettings& settings, Ray ray,
   return trace_path_t<kFeatAll>(scene, settings, ray, rng, rays);
 }
 
+// Textured scenes take the generic loop rather than eight more instantiations of each loop (build
+// time, code size); they pay its run-time checks of the material kinds they lack.
 PathBatchTracer path_batch_tracer_for(uint32_t bits, const PathSettings& settings) {
   if (settings.hemisphere) return nullptr;  // -H casts its direct-light rays one at a time
+  if (bits & kFeatTexture) return trace_paths_t<kFeatAll>;
   static const PathBatchTracer table[] = {
       trace_paths_t<0>, trace_paths_t<1>, trace_paths_t<2>, trace_paths_t<3>,
       trace_paths_t<4>, trace_paths_t<5>, trace_paths_t<6>, trace_paths_t<7>,
   };
-  static_assert(sizeof(table) / sizeof(table[0]) == kFeatAll + 1, "one instantiation per feature combination");
-  return table[bits & kFeatAll];
+  static_assert(sizeof(table) / sizeof(table[0]) == kFeatTexture, "one instantiation per untextured feature combination");
+  return table[bits & (kFeatTexture - 1)];
 }
 
 PathTracer path_tracer_for(uint32_t bits) {
+  if (bits & kFeatTexture) return trace_path_t<kFeatAll>;
   static const PathTracer table[] = {
       trace_path_t<0>, trace_path_t<1>, trace_path_t<2>, trace_path_t<3>,
       trace_path_t<4>, trace_path_t<5>, trace_path_t<6>, trace_path_t<7>,
   };
-  static_assert(sizeof(table) / sizeof(table[0]) == kFeatAll + 1, "one instantiation per feature combination");
-  return table[bits & kFeatAll];
+  static_assert(sizeof(table) / sizeof(table[0]) == kFeatTexture, "one instantiation per untextured feature combination");
+  return table[bits & (kFeatTexture - 1)];
 }
 
 }  // namespace pt

@@ -143,6 +143,10 @@ bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s) {
         float c = dot(-s.wi, light.direction);
         if (c < light.cos_cutoff) return false;
         falloff = light.exponent > 0 ? std::pow(std::max(c, 0.0f), light.exponent) : 1.0f;
+        if (light.cos_inner <= 1) {  // KHR_lights_punctual's recommended smooth edge
+          float t = clampf((c - light.cos_cutoff) / std::max(1e-3f, light.cos_inner - light.cos_cutoff), 0.0f, 1.0f);
+          falloff *= t * t;
+        }
       }
       s.radiance = light.color * (falloff / dist2);
       s.pdf = 1;
@@ -156,10 +160,15 @@ bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s) {
       s.infinite = true;
       return true;
     case LightKind::ambient: {
-      Vec3 h = sample_uniform_hemisphere(u);  // around +Y
-      s.wi = Vec3(h.x, h.z, h.y);
+      if (light.sphere) {
+        s.wi = sample_uniform_sphere(u);
+        s.pdf = uniform_sphere_pdf();
+      } else {
+        Vec3 h = sample_uniform_hemisphere(u);  // around +Y
+        s.wi = Vec3(h.x, h.z, h.y);
+        s.pdf = uniform_hemisphere_pdf();
+      }
       s.radiance = light.color;
-      s.pdf = uniform_hemisphere_pdf();
       s.infinite = true;
       return true;
     }
@@ -181,13 +190,13 @@ float area_light_pdf(const Light& light, Vec3 p, Vec3 light_point, Vec3 n_light)
 }
 
 Vec3 infinite_light_radiance(const Light& light, Vec3 dir) {
-  if (light.kind == LightKind::ambient) return dir.y > 0 ? light.color : Vec3(0.0f);
+  if (light.kind == LightKind::ambient) return dir.y > 0 || light.sphere ? light.color : Vec3(0.0f);
   if (light.kind == LightKind::environment) return light.env->lookup(dir);
   return Vec3(0.0f);
 }
 
 float infinite_light_pdf(const Light& light, Vec3 dir) {
-  if (light.kind == LightKind::ambient) return dir.y > 0 ? uniform_hemisphere_pdf() : 0;
+  if (light.kind == LightKind::ambient) return light.sphere ? uniform_sphere_pdf() : dir.y > 0 ? uniform_hemisphere_pdf() : 0;
   if (light.kind == LightKind::environment) return light.env->pdf(dir);
   return 0;
 }

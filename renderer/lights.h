@@ -42,6 +42,8 @@ struct Light {
   float area = 0;        // rect and mesh
   float cos_cutoff = -1; // spot: cosine of the half angle
   float exponent = 0;    // spot fall-off exponent
+  float cos_inner = 2;   // spot: cosine of the full-intensity cone's half angle (glTF); > 1: none
+  bool sphere = false;   // ambient: every direction, not only the +Y hemisphere (the default light)
   std::vector<Vec3> triangles;  // mesh: three corners per triangle, world space
   std::vector<Vec3> triangle_normals;  // mesh: each triangle's unit normal, kept off the sampling path
   Distribution1D triangle_distribution;

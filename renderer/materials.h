@@ -33,7 +33,7 @@ inline bool diffuse_sample(const Material& m, Vec3 wo, Vec2 u, BsdfSample& s) {
 // normals turn to the viewer, and a shading normal facing away falls back to the geometric one
 // (lane1::face_viewer). Transmissive surfaces keep theirs (z > 0 is outside). Camera and light
 // paths both use it, so that they agree on every vertex they share.
-inline void face_viewer(Vec3 wo, bool transmissive, Vec3& ng, Vec3& ns) {
+[[gnu::always_inline]] inline void face_viewer(Vec3 wo, bool transmissive, Vec3& ng, Vec3& ns) {
   if (!transmissive) lane1::face_viewer(wo, ng, ns);
 }
 

@@ -93,6 +93,7 @@ SceneBase make_scene_base(const SceneDesc& desc) {
         l.direction = ld.direction;
         l.cos_cutoff = std::cos(std::min(ld.spot_angle_deg, 360.0f) * 0.5f * kPi / 180);
         l.exponent = ld.spot_exponent;
+        if (ld.spot_inner_deg >= 0) l.cos_inner = std::cos(std::min(ld.spot_inner_deg, 360.0f) * 0.5f * kPi / 180);
         break;
       case LightType::directional: l.kind = LightKind::directional; l.direction = ld.direction; break;
       case LightType::ambient: l.kind = LightKind::ambient; break;
@@ -163,6 +164,31 @@ SceneBase make_scene_base(const SceneDesc& desc) {
   }
   for (const Light& l : base.lights)
     if (l.kind == LightKind::ambient) f.bits |= kFeatInfinite;
+  // Textured materials: diffuse, on meshes that carry what they read (the loaders guarantee it).
+  for (size_t mi = 0; mi < desc.meshes.size(); ++mi) {
+    const MeshDesc& mesh = desc.meshes[mi];
+    for (int t : mesh.tri_material) {
+      const Material& m = base.materials[size_t(t)];
+      if (!m.textured()) continue;
+      if (m.type != MaterialType::diffuse || (m.texture >= 0 && (mesh.uvs.size() != mesh.positions.size() ||
+                                                                  size_t(m.texture) >= desc.textures.size())) ||
+          (m.vertex_color && mesh.colors.size() != mesh.positions.size()))
+        throw std::runtime_error(desc.source + ": material '" + m.name + "' is textured but mesh '" + mesh.name +
+                                 "' cannot give it texture coordinates or colours");
+      f.bits |= kFeatTexture;
+      break;
+    }
+  }
+  for (const SphereDesc& s : desc.spheres)
+    if (base.materials[size_t(s.material)].textured())
+      throw std::runtime_error(desc.source + ": sphere '" + s.name + "' has a textured material");
+  if (f.bits & kFeatTexture) {
+    base.textures = std::make_shared<const std::vector<TextureDesc>>(desc.textures);
+    f.textured = true;
+    f.textures = desc.textures.size();
+    f.bits = kFeatAll;  // textured scenes take the generic loop (path_tracer_for)
+  }
+  base.default_light = desc.default_light;
   base.triangle_count = desc.triangle_count();
   base.sphere_count = desc.spheres.size();
   base.camera = desc.camera;
@@ -196,6 +222,8 @@ size_t SceneBase::memory_bytes() const {
   size_t bytes = accel ? accel->memory_bytes() : 0;
   bytes += materials.capacity() * sizeof(Material) + lights.capacity() * sizeof(Light);
   bytes += object_bounds.capacity() * sizeof(Bounds3) + caustic_targets.capacity() * sizeof(CausticTarget);
+  if (textures)
+    for (const TextureDesc& t : *textures) bytes += t.texels.capacity();
   for (const Light& l : lights)  // mesh lights: corners, normals, and the area distribution (float + double cdf)
     bytes += (l.triangles.capacity() + l.triangle_normals.capacity()) * sizeof(Vec3) + l.triangle_distribution.size() * (sizeof(float) + sizeof(double));
   return bytes;
@@ -209,6 +237,7 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
   rs->materials = std::move(base.materials);
   rs->lights = std::move(base.lights);
   rs->accel = std::move(base.accel);
+  rs->textures = std::move(base.textures);
   rs->triangle_count = base.triangle_count;
   rs->sphere_count = base.sphere_count;
   SceneFeatures& f = rs->features;
@@ -225,6 +254,20 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
     rs->lights.push_back(std::move(l));
     std::set<std::string> kinds(f.lights.begin(), f.lights.end());
     kinds.insert("environment");
+    f.lights.assign(kinds.begin(), kinds.end());
+  }
+  if (base.default_light && params.default_light && rs->lights.empty()) {
+    // As glTF viewers light an unlit scene: white from every direction, unseen by camera rays.
+    std::fprintf(stderr, "warning: %s: no lights and no emissive surfaces: lit by a uniform white environment "
+                 "(--no-default-light: none)\n", base.source.c_str());
+    Light l;
+    l.kind = LightKind::ambient;
+    l.name = "default environment";
+    l.color = Vec3(1.0f);
+    l.sphere = true;
+    rs->lights.push_back(std::move(l));
+    std::set<std::string> kinds(f.lights.begin(), f.lights.end());
+    kinds.insert("ambient");
     f.lights.assign(kinds.begin(), kinds.end());
   }
   for (size_t i = 0; i < rs->lights.size(); ++i)
@@ -260,6 +303,13 @@ std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams
 std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
   params.validate();  // before the build: a bad option fails fast
   return view_of(make_scene_base(desc), params);
+}
+
+[[gnu::noinline]] const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
+  thread_local Material scratch;
+  scratch.type = MaterialType::diffuse;
+  scratch.albedo = albedo_at(scene, m, hit);
+  return scratch;
 }
 
 float autofocus_distance(const RenderScene& scene, float sx, float sy) {

@@ -15,6 +15,7 @@
 #include "lights.h"
 #include "options.h"
 #include "scene.h"
+#include "texture.h"
 
 namespace pt {
 
@@ -23,7 +24,8 @@ enum FeatureBits : uint32_t {
   kFeatDelta = 1,        // mirror, glass or refraction materials
   kFeatMicrofacet = 2,   // microfacet materials
   kFeatInfinite = 4,     // ambient or environment lights (escaping rays look them up)
-  kFeatAll = 7,
+  kFeatTexture = 8,      // textured materials (texture or vertex colours): such scenes take the generic loop
+  kFeatAll = 15,
 };
 
 struct SceneFeatures {
@@ -31,6 +33,8 @@ struct SceneFeatures {
   bool spheres = false, meshes = false, environment = false, thin_lens = false;
   bool adaptive = false, shading_normals = false;
   bool caustic_tracing = false;  // caustics by light tracing (caustics.h)
+  bool textured = false;         // textured materials (textures or vertex colours)
+  size_t textures = 0;           // textures the materials read per hit
   uint32_t bits = kFeatAll;  // which specialised path loop runs
 };
 
@@ -40,6 +44,8 @@ struct SceneFeatures {
 struct SceneBase {
   std::vector<Material> materials;  // the file's, then one emission material per area-light panel
   std::vector<Light> lights;        // without the environment map (that is a render option)
+  std::shared_ptr<const std::vector<TextureDesc>> textures;  // what textured materials read
+  bool default_light = false;       // SceneDesc::default_light: a view may add the white environment
   std::shared_ptr<const Accel> accel;
   SceneFeatures features;           // what the file contains; a view adds the options' features
   size_t triangle_count = 0, sphere_count = 0;
@@ -67,6 +73,7 @@ struct RenderScene {
   std::vector<int> infinite_lights;  // ambient / environment, looked up when rays escape
   int environment_light = -1;        // visible to camera rays
   std::shared_ptr<const EnvironmentMap> environment;
+  std::shared_ptr<const std::vector<TextureDesc>> textures;  // shared with the SceneBase
   std::shared_ptr<const Accel> accel;  // shared with the SceneBase and its other views
   Camera camera;
   SceneFeatures features;
@@ -77,6 +84,25 @@ struct RenderScene {
   std::vector<int> caustic_lights;
   Distribution1D caustic_light_distribution;
 };
+
+// A textured material's albedo at a hit: its albedo times its texture at the hit's uv and the
+// hit's vertex colour (Material::texture, vertex_color).
+inline Vec3 albedo_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
+  Vec3 a = m.albedo;
+  if (m.texture >= 0) a = a * eval_texture((*scene.textures)[size_t(m.texture)], hit.uv);
+  if (m.vertex_color) a = a * Vec3(srgb8_to_linear(hit.color[0]), srgb8_to_linear(hit.color[1]), srgb8_to_linear(hit.color[2]));
+  return a;
+}
+
+// A textured material at a hit: a diffuse material with the albedo there, held per thread until
+// the thread's next call (textured materials are diffuse: make_scene_base checks). Out of line, so
+// that the loops that may meet one stay as small as without textures.
+const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit);
+
+// The material a path sees at a hit: `m`, or textured_material for a textured one.
+inline const Material& material_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
+  return __builtin_expect(m.textured(), 0) ? textured_material(scene, m, hit) : m;
+}
 
 // Builds what the integrator needs from the file's description: lights (area lights also as
 // visible panels, emissive meshes as mesh lights), the environment map, the camera, the BVH.

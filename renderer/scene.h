@@ -22,6 +22,24 @@ struct Material {
   float alpha = 0.5f;             // microfacet Beckmann roughness
   Vec3 eta{1, 1, 1}, k{0, 0, 0};  // microfacet conductor, per RGB channel
   Vec3 radiance{0, 0, 0};         // emission
+  // Diffuse only: the albedo is multiplied at each hit by this texture at the hit's uv and, with
+  // vertex_color, by the mesh's interpolated vertex colour (the meshes carry uvs / colors then).
+  int texture = -1;
+  bool vertex_color = false;
+  bool textured() const { return texture >= 0 || vertex_color; }
+};
+
+// How texture coordinates outside [0, 1] wrap (glTF sampler wrapS / wrapT).
+enum class TextureWrap { repeat, clamp, mirror };
+
+// A colour texture as the file stores it: sRGB-encoded 8-bit RGB, the top row first; uv (0, 0) is
+// the top-left corner of the image (glTF 2.0, section 3.8.4.2). Filtered bilinearly, or nearest.
+struct TextureDesc {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<uint8_t> texels;  // 3 bytes a texel
+  TextureWrap wrap_s = TextureWrap::repeat, wrap_t = TextureWrap::repeat;
+  bool nearest = false;
 };
 
 // Light kinds that come from <light> elements (emissive meshes are found from their material).
@@ -37,6 +55,9 @@ struct LightDesc {
   Vec3 dim_x{1, 0, 0}, dim_y{0, 1, 0};  // area rectangle edges (full lengths)
   float spot_angle_deg = 45;    // full cone angle (COLLADA falloff_angle)
   float spot_exponent = 0;      // COLLADA falloff_exponent: cos^e fall-off inside the cone
+  // glTF: the full angle of the cone of full intensity; from it to spot_angle_deg the intensity
+  // falls as KHR_lights_punctual recommends (squared, linear in the cosine). < 0: no such cone.
+  float spot_inner_deg = -1;
 };
 
 struct MeshDesc {
@@ -45,6 +66,8 @@ struct MeshDesc {
   std::vector<uint32_t> indices;   // three per triangle
   std::vector<int> tri_material;   // one material index per triangle
   std::vector<Vec3> normals;       // per-vertex shading normals; empty means flat shading
+  std::vector<Vec2> uvs;           // per-vertex texture coordinates, or empty
+  std::vector<Vec3> colors;        // per-vertex linear RGB colours, or empty
 };
 
 struct SphereDesc {
@@ -60,6 +83,9 @@ struct CameraDesc {
   float aspect = 0;
   float znear = 0.001f, zfar = 1000;
   Mat4 world;  // camera-to-world, after the up-axis conversion
+  // glTF: placed as authored whatever --file-camera says, keeping the vertical field of view (the
+  // course's bounding-box framing is for COLLADA scenes).
+  bool as_authored = false;
 };
 
 struct SceneDesc {
@@ -68,7 +94,11 @@ struct SceneDesc {
   std::vector<MeshDesc> meshes;
   std::vector<SphereDesc> spheres;
   std::vector<LightDesc> lights;
+  std::vector<TextureDesc> textures;
   CameraDesc camera;
+  // glTF: without lights and emitters the render adds a uniform white environment (as glTF viewers
+  // light such a scene; the course renders it black); RenderParams::default_light turns it off.
+  bool default_light = false;
 
   size_t triangle_count() const;
   // Bounds of all meshes and spheres (lights excluded), as the course's camera framing uses.

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Fuzzes the scene loader (parse_collada + make_render_scene, tests/fuzz_collada.cpp) and then what
-# the server interprets in a request (headers, job spec JSON, UTF-8 repair: tests/fuzz_http.cpp,
-# for half as long) with libFuzzer in its own tree build-fuzz
-# (clang, -fsanitize=fuzzer,address,undefined). The loader is seeded with scenes/,
-# ../shared/scenes-cs184/ (copied at run time: the course scenes stay out of the repository) and
-# the regression inputs. Exits non-zero on a finding: crash-*, timeout-*, oom-* in build-fuzz/findings;
+# Fuzzes the scene loaders (parse_collada + make_render_scene, tests/fuzz_collada.cpp; the glTF
+# reader, tests/fuzz_gltf.cpp, as long) and then what the server interprets in a request (headers,
+# job spec JSON, UTF-8 repair: tests/fuzz_http.cpp, for half as long) with libFuzzer in its own
+# tree build-fuzz (clang, -fsanitize=fuzzer,address,undefined). The COLLADA loader is seeded with
+# scenes/, ../shared/scenes-cs184/ (copied at run time: the course scenes stay out of the
+# repository) and the regression inputs; the glTF reader with tests/fuzz-gltf-seeds/ and the
+# regression inputs named .gltf / .glb. Exits non-zero on a finding: crash-*, timeout-*, oom-* in build-fuzz/findings;
 # each one fixed becomes a file in tests/fuzz-regressions/ (test_hostile_scenes loads them all).
 # Usage: scripts/fuzz.sh [SECONDS] [libFuzzer flags...]   (default 60 s, as scripts/test.sh runs it)
 set -euo pipefail
@@ -17,7 +18,7 @@ if [ ! -f build-fuzz/build.ninja ]; then
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=address,undefined" > /dev/null
 fi
-cmake --build build-fuzz --target fuzz_collada fuzz_http
+cmake --build build-fuzz --target fuzz_collada fuzz_gltf fuzz_http
 corpus=build-fuzz/corpus
 mkdir -p "$corpus" build-fuzz/findings
 for seed in scenes/*.dae ../shared/scenes-cs184/*.dae tests/fuzz-regressions/*; do
@@ -33,6 +34,15 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 ./build-fuzz/tests/fuzz_collada -max_total_time="$seconds" -max_len=131072 -timeout=10 -rss_limit_mb=2048 \
   -close_fd_mask=2 -dict=tests/fuzz_collada.dict -artifact_prefix=build-fuzz/findings/ -print_final_stats=1 \
   "$@" "$corpus"
+gltf_corpus=build-fuzz/corpus-gltf
+mkdir -p "$gltf_corpus"
+for seed in tests/fuzz-gltf-seeds/* tests/fuzz-regressions/*.gltf tests/fuzz-regressions/*.glb; do
+  if [ -f "$seed" ]; then cp "$seed" "$gltf_corpus"/; fi
+done
+chmod u+w "$gltf_corpus"/*
+./build-fuzz/tests/fuzz_gltf -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
+  -close_fd_mask=2 -dict=tests/fuzz_gltf.dict -artifact_prefix=build-fuzz/findings/gltf- -print_final_stats=1 \
+  "$@" "$gltf_corpus"
 http_corpus=build-fuzz/corpus-http
 mkdir -p "$http_corpus"
 cp tests/fuzz-http-seeds/* "$http_corpus"/

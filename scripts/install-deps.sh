@@ -4,6 +4,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config python3
   libembree-dev libopenimageio-dev openimageio-tools libpugixml-dev libtbb-dev
+  libtinygltf-dev  # glTF 2.0 scenes (header-only tinygltf; its images are decoded by OpenImageIO)
   libgtest-dev libcpp-httplib-dev nlohmann-json3-dev libglfw3-dev xvfb
   libgl1-mesa-dri xauth  # the window tests: Mesa's llvmpipe OpenGL under Xvfb
   chromium nodejs npm  # the web page's browser test (tests/web: playwright-core drives this Chromium)

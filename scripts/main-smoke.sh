@@ -41,8 +41,11 @@ page=$(get "") || fail "GET / failed"
 grep -q "<title>" <<< "$page" || fail "GET / did not return the page"
 get "api/health" > /dev/null || fail "GET /api/health failed"
 scenes=$(get "api/scenes") || fail "GET /api/scenes failed"
-for s in scenes/*.dae; do
-  name=$(basename "$s" .dae)
+shopt -s nullglob
+bundled=(scenes/*.dae scenes/*.gltf scenes/*.glb)
+shopt -u nullglob
+for s in "${bundled[@]}"; do
+  name=$(basename "${s%.*}")
   grep -q "\"name\":\"$name\"" <<< "$scenes" || fail "the bundled scene '$name' is not listed by /api/scenes"
 done
-echo "main-smoke: scripts/main.sh serves the page and the $(ls scenes/*.dae | wc -l) bundled scenes at $url"
+echo "main-smoke: scripts/main.sh serves the page and the ${#bundled[@]} bundled scenes at $url"

@@ -119,8 +119,18 @@ void JobManager::continue_job(const std::string& id, const json& body) {
     if (it.key() != "spp" && it.key() != "target_error" && it.key() != "time_limit")
       throw JobError(JobErrorKind::invalid, "'" + it.key() + "' cannot change when a job continues: only spp, "
                      "target_error and time_limit can", it.key());
+  // The film goes on only over the scene it was rendered from.
+  uint64_t scene_hash = 0;
+  try {
+    scene_hash = m_scenes.check(job->spec.scene);
+  } catch (const JobError& e) {
+    throw JobError(JobErrorKind::conflict, "the job's scene cannot continue: " + std::string(e.what()), "scene");
+  }
   std::lock_guard<std::mutex> lock(m_mutex);
   if (m_stopping) throw JobError(JobErrorKind::shutting_down, "the server is shutting down");
+  if (job->scene_hash != 0 && job->scene_hash != scene_hash)
+    throw JobError(JobErrorKind::conflict, "scene '" + job->spec.scene + "' has changed since this job rendered it: "
+                   "its film cannot continue over another scene (submit a new job)", "scene");
   if (m_queue.size() >= m_config.max_queue)
     throw JobError(JobErrorKind::queue_full, "the queue is full (" + std::to_string(m_config.max_queue) + " jobs waiting); retry later");
   std::lock_guard<std::mutex> jl(job->mutex);
@@ -194,16 +204,24 @@ void JobManager::delete_files(const std::string& id) {
   if (::rmdir(dir.c_str()) != 0) std::fprintf(stderr, "render-server: cannot remove %s\n", dir.c_str());
 }
 
-void JobManager::delete_scene(const std::string& name) {
-  {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    for (auto& kv : m_jobs) {
-      std::lock_guard<std::mutex> jl(kv.second->mutex);
-      if (kv.second->spec.scene == name && !is_final(kv.second->state))
-        throw JobError(JobErrorKind::conflict, "job " + kv.first + " (" + job_state_name(kv.second->state) +
-                       ") renders '" + name + "': cancel it first", "name");
-    }
+// A queued, running or paused job renders the scene it was submitted with: its file stays as it is.
+void JobManager::check_scene_unused(const std::string& name) {
+  std::lock_guard<std::mutex> lock(m_mutex);
+  for (auto& kv : m_jobs) {
+    std::lock_guard<std::mutex> jl(kv.second->mutex);
+    if (kv.second->spec.scene == name && !is_final(kv.second->state))
+      throw JobError(JobErrorKind::conflict, "job " + kv.first + " (" + job_state_name(kv.second->state) +
+                     ") renders '" + name + "': wait for it or cancel it first", "name");
   }
+}
+
+std::pair<json, bool> JobManager::store_scene(const std::string& name, const std::string& bytes) {
+  check_scene_unused(name);
+  return m_scenes.store_upload(name, bytes);
+}
+
+void JobManager::delete_scene(const std::string& name) {
+  check_scene_unused(name);
   m_scenes.remove_upload(name);
 }
 

@@ -18,12 +18,12 @@
 #include <random>
 #include <sstream>
 
-#include "collada.h"
 #include "image.h"
 #include "job_sink.h"
 #include "job_store.h"
 #include "render_backend.h"
 #include "request_policy.h"
+#include "scene_file.h"
 
 namespace srv {
 
@@ -140,15 +140,17 @@ void JobManager::stop() {
     if (w.joinable()) w.join();
 }
 
-JobSpec JobManager::check(const json& body) {
+JobSpec JobManager::check(const json& body, uint64_t* scene_hash) {
   JobSpec spec = parse_job_spec(body, m_config.limits);
   // A scene that does not load is refused here (422) rather than accepted as a job that fails.
-  m_scenes.check(spec.scene);
+  const uint64_t hash = m_scenes.check(spec.scene);
+  if (scene_hash) *scene_hash = hash;
   return spec;
 }
 
 std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const std::string& key) {
-  JobSpec spec = check(body);
+  uint64_t scene_hash = 0;
+  JobSpec spec = check(body, &scene_hash);
   std::lock_guard<std::mutex> lock(m_mutex);
   if (m_stopping) throw JobError(JobErrorKind::shutting_down, "the server is shutting down");
   if (!key.empty()) {
@@ -165,6 +167,7 @@ std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const
   auto job = std::make_shared<Job>();
   job->id = new_job_id();
   job->spec = spec;
+  job->scene_hash = scene_hash;
   job->idempotency_key = key;
   job->created_at = now_unix_seconds();
   {
@@ -259,6 +262,7 @@ double JobManager::focus_distance(const Job& job, double x, double y) {
 void JobManager::write_job_file(Job& j) {
   json doc = status_json(j);
   doc["idempotency_key"] = j.idempotency_key;
+  doc["scene_hash"] = j.scene_hash;
   doc["checkpoint"] = {{"samples", j.checkpoint_samples}, {"seconds", j.checkpoint_seconds}};
   write_file_atomic(job_dir(j.id) + "/job.json", dump_json(doc, 1));
 }
@@ -335,6 +339,7 @@ void JobManager::load_persisted() {
             if (f.is_string()) job->features.push_back(to_valid_utf8(f.get<std::string>()));
         job->width = job->spec.params.width;
         job->height = job->spec.params.height;
+        if (doc.contains("scene_hash") && doc["scene_hash"].is_number_unsigned()) job->scene_hash = doc["scene_hash"];
         if (doc.contains("checkpoint") && doc["checkpoint"].is_object()) {
           job->checkpoint_samples = doc["checkpoint"].value("samples", uint64_t(0));
           job->checkpoint_seconds = doc["checkpoint"].value("seconds", 0.0);

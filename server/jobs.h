@@ -57,6 +57,7 @@ struct Job {
   double progress = 0, elapsed = 0, eta = -1, error_estimate = -1;
   uint64_t samples = 0, rays = 0, nonfinite = 0;
   std::vector<ErrorPoint> history;
+  uint64_t scene_hash = 0;  // the scene file's content when submitted (0: not known); continue needs the same
   uint64_t checkpoint_samples = 0;  // what the job's checkpoint holds (a restart shows these)
   double checkpoint_seconds = 0;
   std::vector<std::string> features;
@@ -108,7 +109,7 @@ class JobManager {
   // Validates and queues; returns the job and whether it was created (false: same idempotency key).
   std::pair<std::shared_ptr<Job>, bool> submit(const json& body, const std::string& idempotency_key);
   // Validates only (scene existence included); returns the normalised spec.
-  JobSpec check(const json& body);
+  JobSpec check(const json& body, uint64_t* scene_hash = nullptr);
   std::shared_ptr<Job> get(const std::string& id) const;
   std::vector<std::shared_ptr<Job>> list() const;
   JobPage page(size_t limit, const std::string& cursor, const std::string& state) const;
@@ -131,6 +132,8 @@ class JobManager {
   uint64_t data_bytes() const;
   // Deletes an uploaded scene (SceneLibrary::remove_upload); conflict while a live job uses it.
   void delete_scene(const std::string& name);
+  // Stores an uploaded scene (SceneLibrary::store_upload); 409 while a live job renders the name.
+  std::pair<json, bool> store_scene(const std::string& name, const std::string& bytes);
 
   json status_json(const Job& job, bool with_history = true) const;  // job.mutex must be held
   // Distance from the job's camera through pixel (x, y) (top-left origin) to the first surface;
@@ -145,6 +148,7 @@ class JobManager {
   bool stopping() const { return m_stopping.load(); }
 
  private:
+  void check_scene_unused(const std::string& name);  // JobError(conflict) while a live job renders it
   void worker_loop();
   void run_job(const std::shared_ptr<Job>& job);
   // Ends a render that stopped without finishing: paused, queued again (shutdown) or cancelled.

@@ -10,7 +10,7 @@
 #include <set>
 
 #include "checkpoint.h"
-#include "collada.h"
+#include "scene_file.h"
 #include "job_store.h"
 #include "film_pass.h"
 #include "jobs.h"
@@ -368,7 +368,7 @@ class RedisBackend : public RenderBackend {
     std::string path = m_scenes.resolve(spec.scene), scene_text;
     if (path.empty() || !read_file(path, scene_text)) throw std::runtime_error("scene '" + spec.scene + "' is gone");
     // A bad file fails here, not once on every worker; the server itself builds no BVH.
-    pt::parse_collada(scene_text, spec.scene + ".dae");
+    pt::parse_scene(scene_text, pt::scene_file_name(spec.scene, scene_text));
     // An unreachable Redis (a restart) is waited for, up to --redis-timeout; a cancel ends the wait.
     RedisClient redis(m_address, 5.0, false);
     redis.set_patience(m_redis_timeout, &stop, "render-server: job " + job.id);

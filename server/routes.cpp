@@ -10,8 +10,8 @@
 #include <regex>
 
 #include "event_stream.h"
-#include "collada.h"
 #include "image.h"
+#include "scene_file.h"
 
 namespace srv {
 
@@ -65,7 +65,7 @@ void put_scene(JobManager& jobs, const ApiOptions&, const Request& req, Response
     throw HttpError(415, std::string("Content-Type must be the scene's own: ") + kSceneMediaTypes);
   const std::string name = req.matches[1];
   try {
-    auto [summary, created] = jobs.scenes().store_upload(name, req.body);
+    auto [summary, created] = jobs.store_scene(name, req.body);
     std::fprintf(stderr, "render-server: scene '%s' uploaded (%zu bytes)\n", name.c_str(), req.body.size());
     send_json(res, created ? 201 : 200, {{"name", name}, {"source", "uploaded"}, {"summary", summary}});
   } catch (const pt::SceneError& e) {

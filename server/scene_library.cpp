@@ -15,18 +15,14 @@
 #include <sstream>
 
 #include "camera.h"
-#include "collada.h"
+#include "scene_file.h"
 
 namespace srv {
 
-namespace {
-
-std::string canonical(const std::string& path) {
+std::string canonical_path(const std::string& path) {
   char buf[PATH_MAX];
   return realpath(path.c_str(), buf) ? std::string(buf) : std::string();
 }
-
-}  // namespace
 
 json summarize_desc(const pt::SceneDesc& d) {
   std::set<std::string> mats, lights;
@@ -47,7 +43,7 @@ json summarize_desc(const pt::SceneDesc& d) {
 
 SceneLibrary::SceneLibrary(std::vector<std::string> dirs, size_t cache_bytes) : m_cache_bytes(cache_bytes) {
   for (const std::string& d : dirs) {
-    std::string c = canonical(d);
+    std::string c = canonical_path(d);
     if (!c.empty()) m_dirs.push_back(c);
   }
 }
@@ -57,8 +53,8 @@ std::string SceneLibrary::resolve(const std::string& name) const {
   std::vector<std::string> dirs = m_dirs;
   if (!m_upload_dir.empty()) dirs.push_back(m_upload_dir);
   for (const std::string& dir : dirs)
-    for (const char* ext : kSceneExtensions) {
-      std::string real = canonical(dir + "/" + name + ext);
+    for (const char* ext : pt::kSceneExtensions) {
+      std::string real = canonical_path(dir + "/" + name + ext);
       // The real file must lie inside the directory: a symlink pointing out is refused.
       if (!real.empty() && real.compare(0, dir.size() + 1, dir + "/") == 0) {
         struct stat st;
@@ -72,12 +68,6 @@ std::string SceneLibrary::file_name(const std::string& name) const {
   const std::string path = resolve(name);
   const size_t dot = path.rfind('.');
   return name + (dot == std::string::npos ? std::string(".dae") : path.substr(dot));
-}
-
-pt::SceneDesc parse_scene_bytes(const std::string& bytes, const std::string& file_name) {
-  if (file_name.size() > 4 && file_name.compare(file_name.size() - 4, 4, ".dae") == 0)
-    return pt::parse_collada(bytes, file_name);
-  throw pt::SceneError(file_name + ": glTF scenes are not read yet (COLLADA .dae only)");
 }
 
 std::string SceneLibrary::read_scene(const std::string& name, uint64_t* hash) const {
@@ -161,7 +151,7 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
   json summary;
   try {
     auto t0 = std::chrono::steady_clock::now();
-    pt::SceneDesc desc = parse_scene_bytes(bytes, file_name(name));
+    pt::SceneDesc desc = pt::parse_scene(bytes, pt::scene_file_name(name, bytes));
     std::string().swap(bytes);
     summary = summarize_desc(desc);
     base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(desc));
@@ -200,7 +190,7 @@ json SceneLibrary::list() {
     if (!d) continue;
     while (dirent* e = readdir(d)) {
       std::string f = e->d_name;
-      for (const char* ext : kSceneExtensions) {
+      for (const char* ext : pt::kSceneExtensions) {
         const size_t n = std::strlen(ext);
         if (f.size() > n && f.compare(f.size() - n, n, ext) == 0 && valid_scene_name(f.substr(0, f.size() - n)))
           names.insert(f.substr(0, f.size() - n));
@@ -255,10 +245,11 @@ SceneLibrary::FileSummary SceneLibrary::file_summary(const std::string& name) {
   return cached;
 }
 
-void SceneLibrary::check(const std::string& name) {
+uint64_t SceneLibrary::check(const std::string& name) {
   if (resolve(name).empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "scene");
-  const std::string error = file_summary(name).error;
-  if (!error.empty()) throw JobError(JobErrorKind::scene_broken, "scene '" + name + "' does not load: " + error, "scene");
+  const FileSummary file = file_summary(name);
+  if (!file.error.empty()) throw JobError(JobErrorKind::scene_broken, "scene '" + name + "' does not load: " + file.error, "scene");
+  return file.hash;
 }
 
 json SceneLibrary::summary(const std::string& name, uint64_t* content_hash) {
@@ -274,7 +265,7 @@ json SceneLibrary::summary(const std::string& name, uint64_t* content_hash) {
     forget_unused();
   }
   if (summary.is_null()) {  // parsed for its summary only: the base is built by the first job
-    summary = summarize_desc(parse_scene_bytes(bytes, file_name(name)));
+    summary = summarize_desc(pt::parse_scene(bytes, pt::scene_file_name(name, bytes)));
     std::lock_guard<std::mutex> lock(m_mutex);
     if (m_last_hash[name] == hash) m_cache[hash].summary = summary;
   }

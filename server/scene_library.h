@@ -18,10 +18,8 @@
 
 namespace srv {
 
-// The scene files the server reads, by extension, in the order a name is looked up.
-inline constexpr const char* kSceneExtensions[] = {".dae", ".glb", ".gltf"};
-// Parses a scene file's bytes by its name's extension; throws pt::SceneError naming `file_name`.
-pt::SceneDesc parse_scene_bytes(const std::string& bytes, const std::string& file_name);
+// The real path of `path` with every symlink resolved, or "" when it does not exist.
+std::string canonical_path(const std::string& path);
 // What GET /api/scenes says of a scene: counts, materials, lights, the course camera's focus distance.
 json summarize_desc(const pt::SceneDesc& desc);
 
@@ -37,7 +35,7 @@ class SceneLibrary {
   // scenes can be replaced and deleted; bundled ones (--scenes) cannot.
   void set_upload_dir(const std::string& dir);
   bool is_uploaded(const std::string& name) const;
-  // Loads `bytes` (COLLADA, or glTF once the loader reads it) and, when it loads, stores it as
+  // Loads `bytes` (COLLADA, or a self-contained glTF / GLB) and, when it loads, stores it as
   // scene `name`, atomically. Returns the summary and whether the name is new. Throws
   // pt::SceneError with the loader's message for a file that does not load, JobError(read_only)
   // for a bundled scene's name, JobError(invalid) for a bad name.
@@ -58,8 +56,9 @@ class SceneLibrary {
   // One scene as list() shows it; JobError(not_found) for an unknown name.
   json entry(const std::string& name);
   // Throws JobError(not_found) for an unknown name, JobError(scene_broken) naming the loader's
-  // message for a file that does not load (parsed once per file version).
-  void check(const std::string& name);
+  // message for a file that does not load (parsed once per file version). Returns the hash of the
+  // file's content, which a job keeps to know its scene is the one its film was rendered from.
+  uint64_t check(const std::string& name);
 
  private:
   using Base = std::shared_ptr<const pt::SceneBase>;

@@ -8,33 +8,13 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "collada.h"
 #include "job_store.h"
+#include "scene_file.h"
 #include "scene_library.h"
 
 namespace srv {
 
-namespace {
-
-// The format by content, not by what the client calls it: a GLB starts with "glTF", a glTF file
-// is a JSON object, anything else is read as COLLADA (whose parser names what is wrong).
-const char* sniff_extension(const std::string& bytes) {
-  if (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) return ".glb";
-  for (unsigned char c : bytes) {
-    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;
-    return c == '{' ? ".gltf" : ".dae";
-  }
-  return ".dae";
-}
-
-std::string canonical_dir(const std::string& path) {
-  char buf[PATH_MAX];
-  return realpath(path.c_str(), buf) ? std::string(buf) : std::string();
-}
-
-}  // namespace
-
-void SceneLibrary::set_upload_dir(const std::string& dir) { m_upload_dir = canonical_dir(dir); }
+void SceneLibrary::set_upload_dir(const std::string& dir) { m_upload_dir = canonical_path(dir); }
 
 bool SceneLibrary::is_uploaded(const std::string& name) const {
   const std::string path = resolve(name);
@@ -49,20 +29,22 @@ std::pair<json, bool> SceneLibrary::store_upload(const std::string& name, const 
   const bool created = existing.empty();
   if (!created && !is_uploaded(name))
     throw JobError(JobErrorKind::read_only, "'" + name + "' is a bundled scene: choose another name", "name");
-  const char* ext = sniff_extension(bytes);
-  // Loaded before it is stored: a file that does not load is never offered as a scene.
-  json summary = summarize_desc(parse_scene_bytes(bytes, name + std::string(ext)));
-  write_file_atomic(m_upload_dir + "/" + name + ext, bytes);
+  // The format by content, not by what the client calls it. Loaded before it is stored: a file
+  // that does not load is never offered as a scene. Loaded without a folder: a glTF that names
+  // external buffers or images is refused, as workers receive one file's bytes.
+  const std::string file = pt::scene_file_name(name, bytes);
+  json summary = summarize_desc(pt::parse_scene(bytes, file));
+  write_file_atomic(m_upload_dir + "/" + file, bytes);
   // The same name in another format goes: a name is one scene.
-  for (const char* other : kSceneExtensions)
-    if (std::strcmp(other, ext) != 0) std::remove((m_upload_dir + "/" + name + other).c_str());
+  for (const char* ext : pt::kSceneExtensions)
+    if (file.compare(name.size(), std::string::npos, ext) != 0) std::remove((m_upload_dir + "/" + name + ext).c_str());
   return {summary, created};
 }
 
 void SceneLibrary::remove_upload(const std::string& name) {
   if (resolve(name).empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "name");
   if (!is_uploaded(name)) throw JobError(JobErrorKind::read_only, "'" + name + "' is a bundled scene: it cannot be deleted", "name");
-  for (const char* ext : kSceneExtensions) std::remove((m_upload_dir + "/" + name + ext).c_str());
+  for (const char* ext : pt::kSceneExtensions) std::remove((m_upload_dir + "/" + name + ext).c_str());
   std::lock_guard<std::mutex> lock(m_mutex);
   m_file_summaries.erase(name);
   m_last_hash.erase(name);

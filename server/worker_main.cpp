@@ -18,7 +18,7 @@
 #include <mutex>
 #include <thread>
 
-#include "collada.h"
+#include "scene_file.h"
 #include "session.h"
 #include "job_spec.h"
 #include "redis_queue.h"
@@ -258,7 +258,7 @@ class Worker {
     if (text.type != RedisReply::string)
       throw std::runtime_error("the scene of job '" + name + "' is no longer in Redis");
     auto t0 = std::chrono::steady_clock::now();
-    auto base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(pt::parse_collada(text.str, name + ".dae")));
+    auto base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(pt::parse_scene(text.str, pt::scene_file_name(name, text.str))));
     log("scene '%s' built in %.3f s", name.c_str(),
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     m_bases.emplace_front(hash, base);

@@ -184,6 +184,13 @@ TEST(BenchSmoke, ScalingThreadCount) {
   EXPECT_NE(out.find("--threads must be a whole number from 2 to 1024, not '1'"), std::string::npos) << out;
 }
 
+// The glTF load benchmark writes its grid, loads and builds it, and prints its figures.
+TEST(BenchSmoke, GltfLoad) {
+  std::string out = expect_runs("bench_gltf_load", "", "load + build");
+  EXPECT_NE(out.find("bytes a triangle"), std::string::npos) << out;
+  EXPECT_NE(out.find("target: a 1M-triangle glTF loaded and built in under 1 s"), std::string::npos) << out;
+}
+
 TEST(BenchSmoke, UnknownFlagIsRefused) {
   std::string out;
   EXPECT_EQ(run(std::string(PT_BENCH_DIR) + "/bench_scaling --no-such-flag", out), 2) << out;

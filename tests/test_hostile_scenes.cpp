@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "collada.h"
+#include "scene_file.h"
 #include "session.h"
 #include "test_util.h"
 
@@ -72,7 +73,7 @@ void run_like_the_fuzzer(const std::string& text, const std::string& name) {
   limits.max_values = 2'000'000;
   SceneDesc desc;
   try {
-    desc = parse_collada(text, name, limits);
+    desc = parse_scene(text, name, limits);  // COLLADA or glTF, as the fuzzers read them
   } catch (const SceneError& e) {
     EXPECT_EQ(std::string(e.what()).rfind(name, 0), 0u) << "the message does not name the file: " << e.what();
     return;

@@ -86,6 +86,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--no-adaptive") { p.adaptive = false; }
     else if (a == "--keep-fov") { p.keep_fov = true; }
     else if (a == "--no-caustic-tracing") { p.caustic_tracing = false; }
+    else if (a == "--no-default-light") { p.default_light = false; }
     else if (a == "--sampler") {
       need(a, 1);
       std::string v = args[++i];
@@ -127,8 +128,8 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
 }
 
 std::string usage_text(const std::string& program) {
-  return "Usage: " + program + " [options] <scene.dae>\n"
-"Renders a CS184 COLLADA scene with a Monte Carlo path tracer (Embree 3).\n"
+  return "Usage: " + program + " [options] <scene.dae | scene.gltf | scene.glb>\n"
+"Renders a CS184 COLLADA scene or a glTF 2.0 scene with a Monte Carlo path tracer (Embree 3).\n"
 "\n"
 "Course flags (same meaning as the CS184 pathtracer):\n"
 "  -s <INT>        camera rays (samples) per pixel (default 1; 1 = one ray through the pixel centre)\n"
@@ -160,6 +161,7 @@ std::string usage_text(const std::string& program) {
 "  --keep-fov      -r scales the course's 800x600 view to the output size instead of cropping it\n"
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
+"  --no-default-light    no white environment for a glTF scene without lights or emitters\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"
 "\n"
 "Error and progress against run time (the logs and --reference with -f; the window honours the limits):\n"

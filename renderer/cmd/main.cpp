@@ -13,7 +13,7 @@
 
 #include "checkpoint.h"
 #include "cli.h"
-#include "collada.h"
+#include "scene_file.h"
 #include "diffuse_lanes.h"
 #include "progress.h"
 #include "session.h"
@@ -51,7 +51,10 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
   if (!f.caustic_tracing && caustic_tracing_applies(scene, deeper))
     caustics += " (-s 2 -m 2 or more would light-trace them)";
   std::printf("caustics:         %s\n", caustics.c_str());
-  std::printf("path loop:        %s%s%s%s\n", f.bits == kFeatAll ? "generic" : "specialised:",
+  std::printf("textures:         %s\n", !f.textured ? "no"
+                                      : f.textures ? (std::to_string(f.textures) + " (and vertex colours where meshes have them)").c_str()
+                                                   : "vertex colours");
+  std::printf("path loop:        %s%s%s%s\n", f.bits == kFeatAll ? (f.textured ? "generic (textures)" : "generic") : "specialised:",
               f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
@@ -94,7 +97,7 @@ int main(int argc, char** argv) {
   try {
     if (!o.describe) check_image_output(o.output);  // before the render, not after it
     auto t0 = std::chrono::steady_clock::now();
-    SceneDesc desc = load_collada(o.scene_path);
+    SceneDesc desc = load_scene(o.scene_path);
     auto scene = make_render_scene(desc, o.params);
     double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.describe) return describe_scene(o, desc, *scene, load_s);

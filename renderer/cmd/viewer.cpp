@@ -19,7 +19,7 @@
 #include <sstream>
 #include <thread>
 
-#include "collada.h"
+#include "scene_file.h"
 #include "session.h"
 #include "viewer_loop.h"
 
@@ -537,7 +537,7 @@ int run_viewer(const CliOptions& o) {
   }
   int rc;
   try {
-    SceneDesc desc = load_collada(o.scene_path);
+    SceneDesc desc = load_scene(o.scene_path);
     RenderParams p = o.params;
     p.cell_w = p.cell_h = 0;
     auto scene = make_render_scene(desc, p);

@@ -3,10 +3,11 @@
 
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <sstream>
 
-#include "collada.h"
+#include "scene_file.h"
 
 namespace pt {
 namespace viewer {
@@ -27,7 +28,10 @@ std::string fmt_g(double v) {
 }
 
 std::string scene_base(const std::string& path) {
-  if (path.size() > 4 && path.compare(path.size() - 4, 4, ".dae") == 0) return path.substr(0, path.size() - 4);
+  for (const char* ext : {".dae", ".gltf", ".glb"}) {
+    const size_t n = std::strlen(ext);
+    if (path.size() > n && path.compare(path.size() - n, n, ext) == 0) return path.substr(0, path.size() - n);
+  }
   return path;
 }
 

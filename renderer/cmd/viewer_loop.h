@@ -30,7 +30,7 @@ inline double ms_since(Clock::time_point t) {
 void say(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 // A number as the course prints it (shortest %g).
 std::string fmt_g(double v);
-// The scene path without ".dae": the course names screenshots and camera files after it.
+// The scene path without ".dae" (or ".gltf", ".glb"): the course names screenshots and camera files after it.
 std::string scene_base(const std::string& path);
 
 // ---- state shared by the window thread and the render thread ----

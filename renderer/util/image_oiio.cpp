@@ -189,6 +189,47 @@ std::string check_image_file(const std::string& path, int width, int height) {
   return read_back(path, is_png(path), width, height, 3, OIIO::TypeDesc::FLOAT, nullptr);
 }
 
+std::vector<uint8_t> decode_rgb8(const uint8_t* data, size_t size, size_t max_pixels, int* width, int* height) {
+  // The signature decides the decoder (glTF 2.0 core images are PNG or JPEG), not a MIME type.
+  static const uint8_t png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'}, jpeg[3] = {0xff, 0xd8, 0xff};
+  const char* name = nullptr;
+  if (size >= 8 && std::memcmp(data, png, 8) == 0) name = "texture.png";
+  else if (size >= 3 && std::memcmp(data, jpeg, 3) == 0) name = "texture.jpg";
+  else throw std::runtime_error("not a PNG or JPEG image");
+  // A PNG's chunks must all be there up to IEND: OpenImageIO 2.4's read callback reports a short
+  // read by a longjmp through libpng that skips its own C++ destructors (a leak the fuzzer found).
+  if (name[8] == 'p') {
+    size_t at = 8;
+    for (;;) {
+      if (size - at < 12) throw std::runtime_error("the PNG is cut short");
+      const size_t len = size_t(data[at]) << 24 | size_t(data[at + 1]) << 16 | size_t(data[at + 2]) << 8 | data[at + 3];
+      if (len > size - at - 12) throw std::runtime_error("the PNG is cut short");
+      if (std::memcmp(data + at + 4, "IEND", 4) == 0) break;
+      at += 12 + len;
+    }
+  }
+  OIIO::Filesystem::IOMemReader reader(data, size);
+  auto in = OIIO::ImageInput::open(name, nullptr, &reader);
+  if (!in) throw std::runtime_error("cannot decode the image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
+    throw std::runtime_error("the image has no usable size");
+  const uint64_t pixels = uint64_t(spec.width) * uint64_t(spec.height);
+  if (pixels > max_pixels)
+    throw std::runtime_error(std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels, over the limit of " +
+                             std::to_string(max_pixels));
+  const int nc = spec.nchannels;
+  std::vector<uint8_t> raw(size_t(pixels) * size_t(nc));
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, raw.data()))
+    throw std::runtime_error("cannot decode the image's pixels: " + in->geterror());
+  std::vector<uint8_t> rgb(size_t(pixels) * 3);
+  for (size_t i = 0; i < size_t(pixels); ++i)
+    for (int c = 0; c < 3; ++c) rgb[3 * i + size_t(c)] = raw[i * size_t(nc) + size_t(nc >= 3 ? c : 0)];
+  *width = spec.width;
+  *height = spec.height;
+  return rgb;
+}
+
 std::string writer_problem(const std::string& path) {
   if (OIIO::ImageOutput::create(path)) return "";
   return "cannot write this image format (" + OIIO::geterror() + ")";
@@ -200,6 +241,6 @@ extern "C" __attribute__((visibility("default"))) const pt::ImageModule* pt_imag
   namespace m = pt::oiio_module;
   static const pt::ImageModule table = {pt::kImageModuleAbi, m::write_exr,  m::write_rgb8,    m::encode_png8,
                                         m::encode_exr,       m::read_image, m::writer_problem,
-                                        m::check_image_file};
+                                        m::check_image_file, m::decode_rgb8};
   return &table;
 }

@@ -220,6 +220,14 @@ test('a scene uploaded with the file picker is summarised, selected and renders;
   await page.waitForFunction(() => document.querySelector('#upload-status').dataset.kind === 'error');
   assert.match(await page.textContent('#upload-status'), /^broken\.dae: broken\.dae/);
   assert.ok(!(await api.json('/api/scenes')).scenes.some((sc) => sc.name === 'broken'), 'a broken scene was stored');
+  // A binary glTF, as a browser hands over a type it does not know: the page names the type by extension.
+  const glb = fs.readFileSync(path.join(sourceDir, 'scenes', 'cornell_gltf.glb'));
+  await page.setInputFiles('#f-upload', { name: 'box.glb', mimeType: '', buffer: glb });
+  await page.waitForFunction(() => /Scene 'box' uploaded/.test(document.querySelector('#upload-status').textContent));
+  assert.equal(await page.inputValue('#f-scene'), 'box');
+  assert.match(await page.textContent('#scene-summary'), /triangles/);
+  await submit({ scene: 'box', spp: 2, width: 32, height: 24 });
+  await waitViewerEnded('done');
 });
 
 test('no uncaught errors on the page', () => {

@@ -1,0 +1,84 @@
+// The scene entry point: pick the loader by content and name, read files with the size limit.
+#include "scene_file.h"
+
+#include <cctype>
+#include <fstream>
+
+#include "collada.h"
+#include "gltf.h"
+
+namespace pt {
+
+namespace {
+
+bool has_extension(const std::string& name, const char* ext) {
+  const std::string e(ext);
+  if (name.size() < e.size()) return false;
+  for (size_t i = 0; i < e.size(); ++i)
+    if (std::tolower((unsigned char)name[name.size() - e.size() + i]) != e[i]) return false;
+  return true;
+}
+
+std::string folder_of(const std::string& path) {
+  size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+}  // namespace
+
+const char* scene_format_name(SceneFormat format) {
+  switch (format) {
+    case SceneFormat::collada: return "COLLADA";
+    case SceneFormat::gltf: return "glTF";
+    case SceneFormat::glb: return "binary glTF";
+  }
+  return "?";
+}
+
+const char* const kSceneExtensions[3] = {".dae", ".gltf", ".glb"};
+
+std::string scene_file_name(const std::string& name, const std::string& bytes) {
+  return name + kSceneExtensions[int(detect_scene_format(bytes, ""))];
+}
+
+SceneFormat detect_scene_format(const std::string& bytes, const std::string& name) {
+  if (bytes.compare(0, 4, "glTF") == 0) return SceneFormat::glb;
+  if (has_extension(name, ".dae")) return SceneFormat::collada;
+  if (has_extension(name, ".gltf")) return SceneFormat::gltf;
+  if (has_extension(name, ".glb")) return SceneFormat::glb;
+  size_t i = 0;
+  if (bytes.compare(0, 3, "\xEF\xBB\xBF") == 0) i = 3;  // a UTF-8 byte order mark
+  while (i < bytes.size() && std::isspace((unsigned char)bytes[i])) ++i;
+  return i < bytes.size() && bytes[i] == '{' ? SceneFormat::gltf : SceneFormat::collada;
+}
+
+std::string read_scene_bytes(const std::string& path, const LoadLimits& limits) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw SceneError(path + ": cannot open file");
+  std::streamoff size = in.tellg();
+  if (size < 0) throw SceneError(path + ": cannot read file");
+  if (size_t(size) > limits.max_file_bytes)
+    throw SceneError(path + ": file is " + std::to_string(size) + " bytes, over the limit of " +
+                     std::to_string(limits.max_file_bytes));
+  std::string bytes(size_t(size), '\0');
+  in.seekg(0);
+  if (!in.read(bytes.data(), size)) throw SceneError(path + ": cannot read file");
+  return bytes;
+}
+
+SceneDesc parse_scene(const std::string& bytes, const std::string& name, const LoadLimits& limits,
+                      const std::string& base_dir) {
+  switch (detect_scene_format(bytes, name)) {
+    case SceneFormat::collada: return parse_collada(bytes, name, limits);
+    case SceneFormat::gltf: return parse_gltf(bytes, name, false, limits, base_dir);
+    case SceneFormat::glb: return parse_gltf(bytes, name, true, limits, base_dir);
+  }
+  throw SceneError(name + ": unknown scene format");
+}
+
+SceneDesc load_scene(const std::string& path, const LoadLimits& limits) {
+  return parse_scene(read_scene_bytes(path, limits), path, limits, folder_of(path));
+}
+
+}  // namespace pt

@@ -1,0 +1,305 @@
+// The glTF reader on our scenes and on small documents: counts, the material mapping
+// (docs/gltf.md), lights in photometric units against a hand computation, cameras, textures, the
+// default light, quantized attributes, transforms; the format dispatch and --describe.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "gltf_docs.h"
+#include "materials.h"
+#include "render_scene.h"
+#include "scene_file.h"
+#include "test_util.h"
+#include "texture.h"
+
+using namespace pt;
+using test::GltfDoc;
+using test::json;
+
+namespace {
+
+SceneDesc parse(const GltfDoc& g) { return parse_gltf(g.text(), "t.gltf", false); }
+
+const Material* find_material(const SceneDesc& d, const std::string& name) {
+  for (const Material& m : d.materials)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(Gltf, OurCornellHasTheColladaScenesContents) {
+  SceneDesc d = load_scene(test::own_scene("cornell_gltf.glb"));
+  SceneDesc c = load_scene(test::own_scene("cornell.dae"));
+  // The walls and blocks triangle for triangle, two 64 x 32 UV spheres, the light's quad.
+  EXPECT_EQ(d.meshes.size(), c.meshes.size() + 2 + 1);
+  EXPECT_EQ(d.triangle_count(), c.triangle_count() + 2 * (64 * 32 * 2 - 2 * 64) + 2);
+  EXPECT_TRUE(d.spheres.empty());
+  EXPECT_TRUE(d.lights.empty());  // the area light is an emissive mesh
+  ASSERT_NE(find_material(d, "ceiling_light"), nullptr);
+  EXPECT_EQ(find_material(d, "ceiling_light")->type, MaterialType::emission);
+  EXPECT_NEAR(find_material(d, "ceiling_light")->radiance.y, 11.0f, 1e-4f);
+  ASSERT_NE(find_material(d, "glass"), nullptr);
+  EXPECT_EQ(find_material(d, "glass")->type, MaterialType::glass);
+  EXPECT_FLOAT_EQ(find_material(d, "glass")->ior, 1.5f);
+  EXPECT_EQ(find_material(d, "mirror")->type, MaterialType::mirror);
+  EXPECT_NEAR(find_material(d, "mirror")->albedo.x, 0.95f, 1e-6f);
+  EXPECT_NEAR(find_material(d, "red")->albedo.x, 0.63f, 1e-6f);
+  EXPECT_TRUE(d.camera.present && d.camera.as_authored);
+  EXPECT_NEAR(d.camera.world.point(Vec3(0, 0, 0)).z, 4.8f, 1e-5f);
+  Bounds3 a = d.geometry_bounds(), b = c.geometry_bounds();
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(a.lo[k], b.lo[k], 1e-3f) << k;
+  EXPECT_TRUE(d.default_light);
+}
+
+TEST(Gltf, OurShowcaseMapsEachMaterialLightAndTheCamera) {
+  SceneDesc d = load_scene(test::own_scene("showcase.gltf"));
+  ASSERT_EQ(d.textures.size(), 1u);
+  EXPECT_EQ(d.textures[0].width, 64);
+  EXPECT_EQ(d.textures[0].wrap_s, TextureWrap::repeat);
+  EXPECT_EQ(d.textures[0].wrap_t, TextureWrap::mirror);
+  const Material* floor = find_material(d, "checker floor");
+  ASSERT_NE(floor, nullptr);
+  EXPECT_EQ(floor->type, MaterialType::diffuse);
+  EXPECT_EQ(floor->texture, 0);
+  EXPECT_TRUE(find_material(d, "vertex-coloured wall")->vertex_color);
+  const Material* gold = find_material(d, "rough gold");
+  EXPECT_EQ(gold->type, MaterialType::microfacet);
+  EXPECT_NEAR(gold->alpha, 0.35f * 0.35f, 1e-6f);
+  // The conductor reflects its base colour head on (Gulbrandsen's fit, edge tint = colour).
+  Vec3 f0 = fresnel_conductor(1.0f, gold->eta, gold->k);
+  EXPECT_NEAR(f0.x, 1.0f * 0.999f, 2e-3f);
+  EXPECT_NEAR(f0.y, 0.766f, 1e-4f);
+  EXPECT_NEAR(f0.z, 0.336f, 1e-4f);
+  EXPECT_EQ(find_material(d, "glass")->type, MaterialType::glass);
+  EXPECT_NEAR(find_material(d, "glass")->transmittance.x, 0.95f, 1e-6f);
+  EXPECT_NEAR(find_material(d, "emissive panel")->radiance.y, 5.4f, 1e-5f);
+  for (const MeshDesc& m : d.meshes)  // the panel's front (emitting) face looks down on the scene
+    if (m.name == "panel") {
+      const uint32_t* i = m.indices.data();
+      EXPECT_LT(cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]).y, 0.0f);
+    }
+  ASSERT_EQ(d.lights.size(), 1u);
+  const LightDesc& spot = d.lights[0];
+  EXPECT_EQ(spot.type, LightType::spot);
+  EXPECT_NEAR(spot.spot_angle_deg, 2 * 0.5 * 180 / M_PI, 1e-3);
+  EXPECT_NEAR(spot.spot_inner_deg, 2 * 0.35 * 180 / M_PI, 1e-3);
+  EXPECT_NEAR(spot.color.x, 15000.0 / 683.0, 1e-3);
+  EXPECT_NEAR(dot(spot.direction, normalize(Vec3(-2.5f, -3.5f, -2.5f))), 1.0f, 1e-5f);
+  EXPECT_TRUE(d.camera.present);
+  EXPECT_NEAR(d.camera.yfov_deg, 0.75 * 180 / M_PI, 1e-4);
+}
+
+// KHR_lights_punctual: candela / 683 lm/W is W/sr; at distance d a point light gives I / d^2
+// (W/m^2). Hand computation: 100 cd of colour (1, 0.5, 0.25) at 2 m: 100 / 683 / 4 =
+// 0.0366032 W/m^2 in red. 10 lux of directional light: 10 / 683 = 0.0146413 W/m^2.
+TEST(Gltf, PunctualLightsConvertFromPhotometricUnitsByHand) {
+  EXPECT_NEAR(radiometric_from_photometric(Vec3(1.0f), 683.0).x, 1.0f, 1e-7f);
+  GltfDoc g = test::quad_doc();
+  g.light(json{{"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 100}}, json{{"translation", {0, 0, 2}}});
+  g.light(json{{"type", "directional"}, {"intensity", 10}}, json{{"rotation", {-0.7071068, 0, 0, 0.7071068}}});
+  SceneDesc d = parse(g);
+  ASSERT_EQ(d.lights.size(), 2u);
+  RenderParams p;
+  auto scene = make_render_scene(d, p);
+  ASSERT_EQ(scene->lights.size(), 2u);
+  LightSample s;
+  ASSERT_TRUE(sample_light(scene->lights[0], Vec3(0, 0, 0), Vec2{0.5f, 0.5f}, s));
+  EXPECT_NEAR(s.radiance.x, 0.0366032f, 1e-6f);
+  EXPECT_NEAR(s.radiance.y, 0.0183016f, 1e-6f);
+  EXPECT_NEAR(s.radiance.z, 0.0091508f, 1e-6f);
+  EXPECT_NEAR(s.wi.z, 1.0f, 1e-6f);
+  // Rotated -90 degrees about x, the directional light's -z points down: light travels along -y.
+  ASSERT_TRUE(sample_light(scene->lights[1], Vec3(0, 0, 0), Vec2{0.5f, 0.5f}, s));
+  EXPECT_NEAR(s.radiance.x, 0.0146413f, 1e-6f);
+  EXPECT_NEAR(s.wi.y, 1.0f, 1e-5f);
+}
+
+// The spot's edge: full intensity inside the inner cone, KHR_lights_punctual's squared linear
+// ramp in the cosine to zero at the outer cone.
+TEST(Gltf, SpotLightsFallOffBetweenTheCones) {
+  GltfDoc g = test::quad_doc();
+  g.light(json{{"type", "spot"}, {"intensity", 683}, {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.4}}}},
+          json{{"translation", {0, 0, 1}}});
+  auto scene = make_render_scene(parse(g), RenderParams());
+  const Light& l = scene->lights[0];
+  auto at_angle = [&](double a) {
+    LightSample s;
+    Vec3 p(float(std::tan(a)), 0, 0);  // on the plane z = 0, one unit below the light
+    return sample_light(l, p, Vec2{0.5f, 0.5f}, s) ? double(s.radiance.x) * double(length_squared(p - l.position)) : 0.0;
+  };
+  EXPECT_NEAR(at_angle(0.1), 1.0, 1e-5);
+  EXPECT_NEAR(at_angle(0.45), 0.0, 1e-9);
+  double t = (std::cos(0.3) - std::cos(0.4)) / (std::cos(0.2) - std::cos(0.4));
+  EXPECT_NEAR(at_angle(0.3), t * t, 1e-4);
+}
+
+TEST(Gltf, MetallicRoughnessMapsOntoTheNearerBsdf) {
+  GltfDoc g = test::quad_doc();
+  auto add = [&](const json& pbr, const json& extra = json::object()) {
+    json m = extra;
+    m["pbrMetallicRoughness"] = pbr;
+    int mat = g.material(m);
+    g.mesh(json{{"POSITION", 0}}, 1, mat);
+  };
+  add(json{{"baseColorFactor", {0.8, 0.6, 0.4, 1}}, {"metallicFactor", 0.25}});        // 1: diffuse (1 - m) base
+  add(json{{"baseColorFactor", {0.8, 0.6, 0.4, 1}}, {"metallicFactor", 0.75}, {"roughnessFactor", 0.5}});  // 2
+  add(json{{"metallicFactor", 1}, {"roughnessFactor", 0}});                              // 3: mirror
+  add(json{{"metallicFactor", 0}}, json{{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1}}},
+                                                        {"KHR_materials_ior", {{"ior", 1.33}}}}}});  // 4: glass
+  SceneDesc d = parse(g);
+  ASSERT_EQ(d.materials.size(), 5u);
+  EXPECT_EQ(d.materials[1].type, MaterialType::diffuse);
+  EXPECT_NEAR(d.materials[1].albedo.x, 0.8f * 0.75f, 1e-6f);
+  EXPECT_EQ(d.materials[2].type, MaterialType::microfacet);
+  EXPECT_NEAR(d.materials[2].alpha, 0.25f, 1e-6f);
+  Vec3 f0 = fresnel_conductor(1.0f, d.materials[2].eta, d.materials[2].k);
+  EXPECT_NEAR(f0.y, 0.04f * 0.25f + 0.6f * 0.75f, 1e-4f);  // lerp(0.04, base, metallic)
+  EXPECT_EQ(d.materials[3].type, MaterialType::mirror);
+  EXPECT_EQ(d.materials[4].type, MaterialType::glass);
+  EXPECT_FLOAT_EQ(d.materials[4].ior, 1.33f);
+  // No material: glTF's default (white, metallic 1, roughness 1): a rough white conductor.
+  GltfDoc h = test::quad_doc();
+  h.doc["meshes"][0]["primitives"][0].erase("material");
+  SceneDesc e = parse(h);
+  EXPECT_EQ(e.materials[e.meshes[0].tri_material[0]].type, MaterialType::microfacet);
+}
+
+TEST(Gltf, CameraKeepsItsVerticalFieldOfViewAtAnyImageAspect) {
+  GltfDoc g = test::quad_doc();
+  g.doc["cameras"] = json::array({json{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
+  g.root(json{{"camera", 0}, {"translation", {0, 0, 5}}});
+  SceneDesc d = parse(g);
+  for (auto [w, h] : {std::pair{800, 600}, std::pair{300, 600}}) {
+    CameraParams cp;
+    cp.width = w, cp.height = h;
+    Camera c = make_camera(d, cp);  // without --file-camera: glTF cameras are used as authored
+    EXPECT_NEAR(c.tan_half_h, std::tan(0.25), 1e-5) << w;
+    EXPECT_NEAR(c.tan_half_w, std::tan(0.25) * w / h, 1e-5) << w;
+    EXPECT_NEAR(c.position.z, 5.0f, 1e-6f);
+    EXPECT_NEAR(c.back.z, 1.0f, 1e-6f);
+  }
+  // Orthographic: a warning, and the bounds framed as for a scene without a camera.
+  g.doc["cameras"][0] = json{{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}};
+  EXPECT_FALSE(parse(g).camera.present);
+}
+
+TEST(Gltf, UnlitScenesGetTheDefaultLightUnlessTurnedOff) {
+  SceneDesc d = parse(test::quad_doc());
+  RenderParams p;
+  auto lit = make_render_scene(d, p);
+  ASSERT_EQ(lit->lights.size(), 1u);
+  EXPECT_EQ(lit->lights[0].kind, LightKind::ambient);
+  EXPECT_TRUE(lit->lights[0].sphere);
+  EXPECT_EQ(infinite_light_radiance(lit->lights[0], Vec3(0, -1, 0)).x, 1.0f);  // from below too
+  EXPECT_NE(lit->features.bits & kFeatInfinite, 0u);
+  p.default_light = false;
+  EXPECT_TRUE(make_render_scene(d, p)->lights.empty());
+  // A COLLADA scene never gets it (the course renders an unlit scene black).
+  d.default_light = false;
+  EXPECT_TRUE(make_render_scene(d, RenderParams())->lights.empty());
+}
+
+TEST(Gltf, TexturesWrapAndDecodeSrgb) {
+  TextureDesc t;
+  t.width = 2, t.height = 1;
+  t.texels = {255, 0, 0, 0, 0, 255};  // red, blue
+  t.nearest = true;
+  EXPECT_EQ(eval_texture(t, Vec2{0.25f, 0.5f}).x, 1.0f);
+  EXPECT_EQ(eval_texture(t, Vec2{1.25f, 0.5f}).x, 1.0f);  // repeat
+  t.wrap_s = TextureWrap::clamp;
+  EXPECT_EQ(eval_texture(t, Vec2{1.25f, 0.5f}).z, 1.0f);
+  t.wrap_s = TextureWrap::mirror;
+  EXPECT_EQ(eval_texture(t, Vec2{1.25f, 0.5f}).z, 1.0f);  // [1, 2) runs backwards
+  EXPECT_EQ(eval_texture(t, Vec2{1.75f, 0.5f}).x, 1.0f);
+  t.nearest = false;
+  t.wrap_s = TextureWrap::clamp;
+  EXPECT_NEAR(eval_texture(t, Vec2{0.5f, 0.5f}).x, 0.5f, 1e-6f);  // halfway between the centres
+  EXPECT_NEAR(srgb8_to_linear(128), 0.2158605f, 1e-6f);             // IEC 61966-2-1
+  EXPECT_NEAR(texture_mean(t).z, 0.5f, 1e-6f);
+}
+
+// KHR_mesh_quantization: normalized bytes and shorts, read through the accessor as glTF 3.11 says.
+TEST(Gltf, QuantizedAttributesAreNormalized) {
+  GltfDoc g;
+  // Strided as the extension requires: each 6-byte position and 2-byte uv padded to 4 bytes.
+  std::vector<int16_t> pos = {-32767, 0, 0, 0, 32767, 0, 0, 0, 0, 32767, 0, 0};
+  int p = g.accessor(g.view(test::bytes_of(pos), 8), 5122, 3, "VEC3", true);
+  std::vector<uint8_t> uv = {0, 0, 0, 0, 255, 0, 0, 0, 0, 255, 0, 0};
+  int t = g.accessor(g.view(test::bytes_of(uv), 4), 5121, 3, "VEC2", true);
+  int mat = g.material(json{{"pbrMetallicRoughness", {{"metallicFactor", 0}}}});
+  g.mesh(json{{"POSITION", p}, {"TEXCOORD_0", t}}, -1, mat, json{{"scale", {2, 2, 2}}});
+  SceneDesc d = parse(g);
+  ASSERT_EQ(d.meshes.size(), 1u);
+  EXPECT_FLOAT_EQ(d.meshes[0].positions[0].x, -2.0f);
+  EXPECT_FLOAT_EQ(d.meshes[0].positions[2].y, 2.0f);
+  EXPECT_TRUE(d.meshes[0].uvs.empty());  // no texture reads them
+}
+
+TEST(Gltf, NodeTransformsComposeAndMirroringKeepsTheFrontFace) {
+  GltfDoc g = test::quad_doc();
+  // Parent: translate (0, 0, -4); child: rotate 90 degrees about y, then scale x by -1 (mirror).
+  g.doc["nodes"][0] = json{{"translation", {0, 0, -4}}, {"children", {1}}};
+  g.doc["nodes"].push_back(json{{"mesh", 0}, {"rotation", {0, 0.7071068, 0, 0.7071068}}, {"scale", {-1, 1, 1}}});
+  SceneDesc d = parse(g);
+  ASSERT_EQ(d.meshes.size(), 1u);
+  const MeshDesc& m = d.meshes[0];
+  Vec3 v = m.positions[1];  // (1, -1, 0) -> mirrored (-1, -1, 0) -> rotated (0, -1, 1) -> (0, -1, -3)
+  EXPECT_NEAR(v.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(v.z, -3.0f, 1e-6f);
+  // The quad faced +z: the mirror keeps that normal, the turn makes it +x; the winding agrees.
+  const uint32_t* i = m.indices.data();
+  Vec3 n = normalize(cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]));
+  EXPECT_NEAR(n.x, 1.0f, 1e-5f);
+  // The same as one matrix (column-major).
+  GltfDoc h = test::quad_doc();
+  h.doc["nodes"][0]["matrix"] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, -4, 1};
+  EXPECT_NEAR(parse(h).meshes[0].positions[1].z, -3.0f, 1e-6f);
+}
+
+TEST(Gltf, UnsupportedModesAreSkippedWithOneWarning) {
+  GltfDoc g = test::quad_doc();
+  g.doc["meshes"][0]["primitives"].push_back(json{{"attributes", {{"POSITION", 0}}}, {"mode", 1}});
+  g.doc["meshes"][0]["primitives"].push_back(json{{"attributes", {{"POSITION", 0}}}, {"mode", 1}});
+  testing::internal::CaptureStderr();
+  SceneDesc d = parse(g);
+  std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(d.meshes.size(), 1u);
+  EXPECT_NE(err.find("t.gltf: /meshes/0/primitives/1/mode: primitive mode 1 (LINES)"), std::string::npos) << err;
+  EXPECT_EQ(err.find("primitives/2"), std::string::npos) << "one line per mode: " << err;
+  // An unsupported extension that is only used: one warning naming it.
+  g.doc["extensionsUsed"] = {"KHR_texture_transform", "KHR_texture_transform"};
+  testing::internal::CaptureStderr();
+  parse(g);
+  err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("/extensionsUsed/0: extension 'KHR_texture_transform' is not supported"), std::string::npos) << err;
+  EXPECT_EQ(err.find("/extensionsUsed/1"), std::string::npos) << err;
+}
+
+TEST(Gltf, FormatIsPickedByMagicExtensionOrContent) {
+  EXPECT_EQ(detect_scene_format("glTF....", "scene.dae"), SceneFormat::glb);
+  EXPECT_EQ(detect_scene_format("{}", "scene.dae"), SceneFormat::collada);
+  EXPECT_EQ(detect_scene_format("<x/>", "scene.gltf"), SceneFormat::gltf);
+  EXPECT_EQ(detect_scene_format(" \n{\"asset\":{}}", "scene"), SceneFormat::gltf);
+  EXPECT_EQ(detect_scene_format("<?xml?>", "scene"), SceneFormat::collada);
+  EXPECT_EQ(scene_file_name("cornell", "glTF"), "cornell.glb");
+  // The same quad as .gltf and as .glb.
+  GltfDoc g = test::quad_doc();
+  SceneDesc a = parse_scene(g.text(), "q.gltf"), b = parse_scene(g.glb(), "q.glb");
+  ASSERT_EQ(a.meshes.size(), 1u);
+  ASSERT_EQ(b.meshes.size(), 1u);
+  EXPECT_EQ(a.meshes[0].positions[2].y, b.meshes[0].positions[2].y);
+}
+
+TEST(Gltf, DescribeListsAGltfScenesFeatures) {
+  std::string out = test::temp_dir() + "/describe.txt";
+  std::string cmd = std::string(PT_PATHTRACER) + " --describe " + test::own_scene("showcase.gltf") + " > " + out + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  std::ifstream in(out);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  for (const char* want : {"diffuse, emission, glass, microfacet", "mesh, spot", "textures:         1",
+                           "path loop:        generic"})
+    EXPECT_NE(text.find(want), std::string::npos) << want << "\n" << text;
+}
