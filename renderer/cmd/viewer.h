@@ -1,7 +1,7 @@
 // The GLFW debug window (`pathtracer scene.dae` without -f): the progressive render as it
 // converges, the course's render-mode keys, click-to-focus, and a script player for tests.
-// viewer.cpp is the only file that includes GLFW / OpenGL; it is linked into the pathtracer
-// executable only, never into the renderer library.
+// viewer.cpp and viewer_script.cpp are the only files that include GLFW / OpenGL; they are linked
+// into the pathtracer executable only, never into the renderer library.
 #pragma once
 
 #include "cli.h"
