@@ -16,6 +16,7 @@ struct CliOptions {
   bool help = false;
   bool quiet = false;      // --quiet: no progress bar
   std::string script;      // --script: window input replayed from a file (tests)
+  std::string output_dir;  // --output-dir: where the window's S and D keys write (empty: the current directory)
   bool describe = false;   // --describe: print the feature set and memory, no render
   std::string error_log;   // --error-log: CSV of the error per pass
   std::string progress_log;  // --progress-log: CSV of the progress bar's fraction and ETA
@@ -33,7 +34,7 @@ class UsageError : public std::runtime_error {
 // Parses argv; throws UsageError naming the flag on anything malformed.
 CliOptions parse_cli(const std::vector<std::string>& args);
 std::string usage_text(const std::string& program);
-// The debug window's keys, one a line (part of usage_text; the window's H key prints it).
+// The debug window's keys, one a line (part of usage_text; the window's H key shows it).
 std::string window_keys_text();
 // The EXR header of a render: its parameters, achieved samples, wall time and error estimate.
 Metadata render_metadata(const CliOptions& options, const RenderSession& session);

@@ -26,6 +26,7 @@ int key_code(const std::string& name) {
     case ']': return GLFW_KEY_RIGHT_BRACKET;
     case '=': return GLFW_KEY_EQUAL;
     case '-': return GLFW_KEY_MINUS;
+    case '`': return GLFW_KEY_GRAVE_ACCENT;
     default: return -1;
   }
 }
@@ -41,10 +42,10 @@ std::vector<ScriptLine> load_script(const std::string& path) {
     for (std::string w; ws >> w;) l.words.push_back(w);
     if (l.words.empty() || l.words[0][0] == '#') continue;
     const std::string& c = l.words[0];
-    size_t want_args = c == "wait_spp" || c == "wait_ms" || c == "key" || c == "screenshot" ? 1
-                       : c == "click" || c == "resize"                                          ? 2
-                       : c == "sync" || c == "title" || c == "close" || c == "quit"             ? 0
-                                                                                                 : size_t(-1);
+    size_t want_args = c == "wait_spp" || c == "wait_ms" || c == "key" || c == "screenshot"             ? 1
+                       : c == "click" || c == "resize"                                                      ? 2
+                       : c == "sync" || c == "title" || c == "overlay" || c == "close" || c == "quit" ? 0
+                                                                                                            : size_t(-1);
     std::string where = path + ":" + std::to_string(n) + ": ";
     if (want_args == size_t(-1)) throw std::runtime_error(where + "unknown command '" + c + "'");
     if (l.words.size() != want_args + 1)

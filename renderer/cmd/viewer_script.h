@@ -13,7 +13,7 @@ struct ScriptLine {
   std::vector<std::string> words;  // the command, then its arguments
 };
 
-// The GLFW key code of a key name in a script ("L", "]", "Esc"), or -1.
+// The GLFW key code of a key name in a script ("L", "]", "`", "Esc"), or -1.
 int key_code(const std::string& name);
 // Reads and checks the whole script up front; throws naming FILE:LINE.
 std::vector<ScriptLine> load_script(const std::string& path);
