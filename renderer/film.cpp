@@ -31,13 +31,13 @@ void assign_zeroed(std::vector<T>& v, size_t n, const T& zero) {
   v.assign(n, zero);
 }
 
+}  // namespace
+
 // Course colouring: 0 = blue, 0.5 = green, 1 = red, by samples taken / spp.
 Vec3 rate_colour(uint32_t count, int spp) {
   float r = float(count) / float(spp);
   return r <= 0.5f ? Vec3(0, 2 * r, 1 - 2 * r) : Vec3(2 * r - 1, 2 - 2 * r, 0);
 }
-
-}  // namespace
 
 Film::Film(int width, int height, int spp, const AdaptiveRule& rule, bool caustics)
     : m_w(width), m_h(height), m_spp(spp), m_rule(rule) {
@@ -262,6 +262,12 @@ void Film::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const {
   out.clear();
   for (int y = t.y0; y < t.y1; ++y)
     for (int x = t.x0; x < t.x1; ++x) out.push_back(rate_colour(m_count[size_t(y) * m_w + x], m_spp));
+}
+
+void Film::read_tile_count(const Tile& t, std::vector<uint32_t>& out) const {
+  out.clear();
+  for (int y = t.y0; y < t.y1; ++y)
+    for (int x = t.x0; x < t.x1; ++x) out.push_back(m_count[size_t(y) * m_w + x]);
 }
 
 double Film::error_estimate(int threads) const {

@@ -23,6 +23,10 @@ struct Tile {
   int x0, y0, x1, y1;  // film pixels, top-left origin, half-open
 };
 
+// The course's sample-rate colour of a pixel (linear, before tone mapping): 0 samples blue,
+// spp / 2 green, spp red. The rate image and the window's rate legend both use it.
+Vec3 rate_colour(uint32_t count, int spp);
+
 // The course's adaptive sampling (../shared/notes/cs184-spec.md): a pixel is tested after sample n
 // when n > 1 and n - 1 is a multiple of the batch, and stops once the 95% confidence half-width of
 // its luminance is within tolerance x mean. Where samples arrive in blocks (merged passes), a
@@ -213,6 +217,7 @@ class Film {
   // Mean radiance / rate colours of a tile's pixels, row by row. Safe while other tiles render.
   void read_tile(const Tile& t, std::vector<Vec3>& out) const;
   void read_tile_rate(const Tile& t, std::vector<Vec3>& out) const;
+  void read_tile_count(const Tile& t, std::vector<uint32_t>& out) const;  // samples taken
   // Estimated relative MSE of image() (halves_error_estimate), computed once for each state of the
   // statistics; call invalidate_estimate() after changing them.
   double error_estimate(int threads = 1) const;

@@ -93,6 +93,10 @@ TEST(Cli, CourseCommandsParseUnchanged) {
   EXPECT_EQ(o.params.camera_file, "cam.txt");
   EXPECT_EQ(o.params.env_map, "env.exr");
   EXPECT_TRUE(o.output.empty());
+  EXPECT_TRUE(o.output_dir.empty());  // the window saves into the current directory
+
+  o = parse_cli(split("--output-dir shots s.dae"));
+  EXPECT_EQ(o.output_dir, "shots");
 }
 
 TEST(Cli, DefaultsMatchTheCourse) {
@@ -122,6 +126,7 @@ TEST(Cli, BadFlagsAreNamed) {
       {"-f", "-f"},                   {"", "scene"},                 {"a.dae b.dae", "more than one"},
       {"-a 0 0.05 s.dae", "-a"},      {"-t 0 s.dae", "-t"},          {"-l 99999999999 s.dae", "-l"},
       {"-b 2e6 s.dae", "-b: 2e6 is out of range [0, 1e+06]"},  // a number out of range shows the range
+      {"--output-dir s.dae", "scene"},  {"--output-dir d -f x.png s.dae", "--output-dir"},
   };
   for (const Case& c : cases) {
     try {

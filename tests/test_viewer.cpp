@@ -1,153 +1,21 @@
 // The GLFW debug window, run for real under Xvfb (Mesa's llvmpipe) and driven by --script: the
 // framebuffer shows the same image as the CLI render, keys change the settings they name, a
-// click focuses on the surface under it, S / D write next to the scene, resizing re-renders at
-// the window size, and restarting or closing never waits for a long pass.
-#include <gtest/gtest.h>
-
-#include <dirent.h>
-#include <fcntl.h>
-#include <poll.h>
-#include <signal.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
+// click focuses on the surface under it, S / D write into the current directory or --output-dir,
+// resizing re-renders at the window size, and restarting or closing never waits for a long pass.
+// The overlay's own tests: test_viewer_overlay.cpp.
 #include <OpenImageIO/imageio.h>
-#include <chrono>
-#include <cstdlib>
-#include <fstream>
+
 #include <regex>
-#include <sstream>
 
 #include "cli.h"
 #include "collada.h"
 #include "session.h"
-#include "test_util.h"
+#include "viewer_harness.h"
 
 using namespace pt;
+using namespace viewer_test;
 
 namespace {
-
-struct RunResult {
-  int status;
-  std::string output;
-  double seconds;
-};
-
-RunResult run(const std::string& args, const std::string& env = "") {
-  std::string cmd = env + " timeout 120 " + std::string(PT_PATHTRACER) + " " + args + " 2>&1";
-  auto t0 = std::chrono::steady_clock::now();
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  int st = pclose(p);
-  double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out, s};
-}
-
-bool on_path(const std::string& prog) {
-  const char* path = std::getenv("PATH");
-  std::istringstream dirs(path ? path : "");
-  for (std::string d; std::getline(dirs, d, ':');)
-    if (access((d + "/" + prog).c_str(), X_OK) == 0) return true;
-  return false;
-}
-
-std::vector<std::string> files_in(const std::string& dir) {
-  std::vector<std::string> names;
-  if (DIR* d = opendir(dir.c_str())) {
-    while (dirent* e = readdir(d)) if (e->d_type != DT_DIR) names.push_back(e->d_name);
-    closedir(d);
-  }
-  return names;
-}
-
-// An Xvfb server for this test process; -displayfd lets it pick a free display itself, so tests
-// running in parallel never race for one.
-class Xvfb {
- public:
-  ~Xvfb() {
-    if (m_pid > 0) {
-      kill(m_pid, SIGTERM);
-      waitpid(m_pid, nullptr, 0);
-    }
-  }
-  // Returns "" on success, else why not.
-  std::string start() {
-    int fds[2];
-    if (pipe(fds) != 0) return "pipe failed";
-    m_pid = fork();
-    if (m_pid == 0) {
-      close(fds[0]);
-      int devnull = open("/dev/null", O_WRONLY);
-      dup2(devnull, 1);
-      dup2(devnull, 2);
-      std::string fd = std::to_string(fds[1]);
-      execlp("Xvfb", "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "640x480x24", "-nolisten", "tcp", nullptr);
-      _exit(127);
-    }
-    close(fds[1]);
-    std::string number;
-    pollfd pfd{fds[0], POLLIN, 0};
-    while (poll(&pfd, 1, 20000) > 0) {
-      char c;
-      if (read(fds[0], &c, 1) != 1 || c == '\n') break;
-      number += c;
-    }
-    close(fds[0]);
-    if (number.empty()) return "Xvfb did not report a display";
-    m_display = ":" + number;
-    return "";
-  }
-  const std::string& display() const { return m_display; }
-
- private:
-  pid_t m_pid = -1;
-  std::string m_display;
-};
-
-class Viewer : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    if (!on_path("Xvfb")) return;
-    s_xvfb = new Xvfb;
-    s_error = s_xvfb->start();
-    if (s_error.empty()) setenv("DISPLAY", s_xvfb->display().c_str(), 1);
-  }
-  static void TearDownTestSuite() {
-    delete s_xvfb;
-    s_xvfb = nullptr;
-  }
-  void SetUp() override {
-    if (!s_xvfb) GTEST_SKIP() << "Xvfb is not installed (package xvfb)";
-    ASSERT_EQ(s_error, "") << "cannot start Xvfb";
-    m_dir = test::temp_dir() + "/viewer_" + ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    mkdir(m_dir.c_str(), 0755);
-    for (const std::string& f : files_in(m_dir)) unlink((m_dir + "/" + f).c_str());  // earlier runs' files
-    // The scene is copied so that S and D write next to it in a directory of our own.
-    m_scene = m_dir + "/cornell.dae";
-    std::ifstream in(test::own_scene("cornell.dae"));
-    std::ofstream(m_scene) << in.rdbuf();
-  }
-
-  // Runs the window with a script; fails the test unless it exits with status 0.
-  RunResult run_window(const std::string& flags, const std::string& script) {
-    std::string path = m_dir + "/script.txt";
-    std::ofstream(path) << script;
-    RunResult r = run(flags + " --script " + path + " " + m_scene);
-    EXPECT_EQ(r.status, 0) << r.output;
-    return r;
-  }
-
-  static Xvfb* s_xvfb;
-  static std::string s_error;
-  std::string m_dir, m_scene;
-};
-
-Xvfb* Viewer::s_xvfb = nullptr;
-std::string Viewer::s_error;
 
 // Mean absolute difference in 8-bit levels; sizes must match.
 double mean_abs_diff_levels(const std::string& a, const std::string& b) {
@@ -161,24 +29,6 @@ double mean_abs_diff_levels(const std::string& a, const std::string& b) {
   return sum / (3.0 * x.pixels.size());
 }
 
-// The value after `key` on the last line that has it ("focus 4.8 |" -> 4.8).
-double value_after(const std::string& out, const std::string& key) {
-  size_t at = out.rfind(key);
-  if (at == std::string::npos) return NAN;
-  return std::strtod(out.c_str() + at + key.size(), nullptr);
-}
-
-std::string last_line_with(const std::string& out, const std::string& prefix) {
-  std::istringstream in(out);
-  std::string found;
-  for (std::string l; std::getline(in, l);)
-    if (l.rfind(prefix, 0) == 0) found = l;
-  return found;
-}
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 }  // namespace
 
@@ -186,8 +36,8 @@ TEST(ViewerCli, HelpListsTheWindowKeys) {
   RunResult r = run("--help");
   EXPECT_EQ(r.status, 0);
   EXPECT_NE(r.output.find("Window keys"), std::string::npos);
-  for (const char* k : {"R ", ". / ,", "L / K", "' / ;", "] / [", "= / -", "T ", "S ", "D ", "click", "H ", "Esc / Q",
-                        "--script"})
+  for (const char* k : {"R ", ". / ,", "L / K", "' / ;", "] / [", "= / -", "T ", "S ", "D ", "click", "` ", "H ",
+                        "Esc / Q", "--script", "--output-dir"})
     EXPECT_NE(r.output.find(k), std::string::npos) << k;
 }
 
@@ -195,6 +45,12 @@ TEST(ViewerCli, WithoutADisplayExitsWith2AndSaysSo) {
   RunResult r = run(test::own_scene("cornell.dae"), "env -u DISPLAY -u WAYLAND_DISPLAY");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("-f FILE"), std::string::npos) << r.output;
+}
+
+TEST(ViewerCli, AMissingOutputDirIsRefusedBeforeTheWindowOpens) {
+  RunResult r = run("--output-dir /nonexistent/shots " + test::own_scene("cornell.dae"), "env -u DISPLAY");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("--output-dir /nonexistent/shots: not a directory"), std::string::npos) << r.output;
 }
 
 TEST(ViewerCli, BadScriptIsNamedByLine) {
@@ -207,8 +63,8 @@ TEST(ViewerCli, BadScriptIsNamedByLine) {
 
 TEST_F(Viewer, FramebufferMatchesTheCliRender) {
   const std::string flags = "-t 2 -s 64 -m 3 -r 120 90 --seed 3";
-  RunResult w = run_window(flags, "wait_spp 64\nscreenshot " + m_dir + "/window.png\nkey T\nscreenshot " + m_dir +
-                                      "/window_rate.png\nquit\n");
+  RunResult w = run_window(flags, "key `\nwait_spp 64\nscreenshot " + m_dir + "/window.png\nkey T\nscreenshot " +
+                                      m_dir + "/window_rate.png\nquit\n");
   RunResult c = run(flags + " --quiet -f " + m_dir + "/cli.png " + m_scene);
   ASSERT_EQ(c.status, 0) << c.output;
   double d = mean_abs_diff_levels(m_dir + "/window.png", m_dir + "/cli.png");
@@ -230,7 +86,7 @@ TEST_F(Viewer, TheErrorTargetEndsTheRender) {
   EXPECT_LT(std::stoi(m[1]), 65536) << pass;
   EXPECT_LE(std::stod(m[2]), 0.01) << pass;
   const std::string title = last_line_with(o, "title: ");
-  EXPECT_NE(title.find(std::string(m[1]) + "/65536 spp done"), std::string::npos) << title;
+  EXPECT_NE(title.find("spp " + std::string(m[1]) + "/65536 done"), std::string::npos) << title;
 }
 
 // --time-limit ends the window's render as it ends a file render (the same driver): the pass it
@@ -244,17 +100,17 @@ TEST_F(Viewer, TheTimeLimitEndsTheRender) {
   ASSERT_TRUE(std::regex_search(pass, m, std::regex(R"(pass: (\d+)/65536 spp)"))) << pass;
   EXPECT_LT(std::stoi(m[1]), 65536) << pass;
   const std::string title = last_line_with(o, "title: ");
-  EXPECT_NE(title.find(std::string(m[1]) + "/65536 spp done"), std::string::npos) << title;
+  EXPECT_NE(title.find("spp " + std::string(m[1]) + "/65536 done"), std::string::npos) << title;
 }
 
 TEST_F(Viewer, KeysChangeTheSettingsTheyName) {
-  RunResult r = run_window("-t 2 -s 4 -m 3 -r 64 48", R"(wait_spp 1
+  RunResult r = run_window("-t 2 -s 4 -m 3 -r 160 120 --output-dir " + m_dir, R"(wait_spp 1
 key .
 key L
 key '
 key ]
 key =
-title
+overlay
 wait_spp 8
 key S
 sync
@@ -263,7 +119,7 @@ key K
 key ;
 key [
 key -
-title
+overlay
 key R
 key T
 key H
@@ -274,10 +130,12 @@ quit
                            "max depth 3", "lens radius 0", "focal distance 4.7", "spp 4", "light samples 1", "restart",
                            "view: sample rate", "Window keys:"})
     EXPECT_NE(o.find(std::string("\n") + line + "\n"), std::string::npos) << line << "\n" << o;
-  std::string first = o.substr(o.find("title: "));
-  EXPECT_NE(first.find("depth 4 | lens 0.05 | focus 4.8 | light 2"), std::string::npos) << first;
-  std::string last = last_line_with(o, "title: ");
-  EXPECT_NE(last.find("depth 3 | lens 0 | focus 4.7 | light 1"), std::string::npos) << last;
+  // The panel shows the settings.
+  std::string first = o.substr(o.find("overlay: "));
+  first = first.substr(0, first.find('\n'));
+  EXPECT_NE(first.find("max depth 4 | lens radius 0.05 | focal dist 4.8 | light samples 2"), std::string::npos) << o;
+  std::string last = last_line_with(o, "overlay: ");
+  EXPECT_NE(last.find("max depth 3 | lens radius 0 | focal dist 4.7 | light samples 1"), std::string::npos) << last;
   // The saved render was made with the changed settings (its EXR header says so).
   std::string exr;
   for (const std::string& f : files_in(m_dir))
@@ -293,7 +151,7 @@ quit
 }
 
 TEST_F(Viewer, ClickFocusesOnTheSurfaceUnderIt) {
-  RunResult r = run_window("-t 2 -s 2 -b 0.1 -r 120 90", "wait_spp 1\nclick 30 70\nsync\nwait_spp 2\ntitle\nquit\n");
+  RunResult r = run_window("-t 2 -s 2 -b 0.1 -r 120 90", "wait_spp 1\nclick 30 70\nsync\nwait_spp 2\noverlay\nquit\n");
   RenderParams p;
   p.width = 120;
   p.height = 90;
@@ -302,24 +160,49 @@ TEST_F(Viewer, ClickFocusesOnTheSurfaceUnderIt) {
   float expect = autofocus_distance(*scene, 30.0f / 120, 1 - 70.0f / 90);
   ASSERT_TRUE(std::isfinite(expect));
   EXPECT_NE(expect, 4.7f);
-  double shown = value_after(last_line_with(r.output, "title: "), "| focus ");
+  double shown = value_after(last_line_with(r.output, "overlay: "), "| focal dist ");
   EXPECT_NEAR(shown, expect, 1e-5 * expect) << r.output;
   EXPECT_NEAR(value_after(r.output, "focal distance "), expect, 1e-5 * expect) << r.output;
 }
 
-TEST_F(Viewer, SaveAndCameraKeysWriteNextToTheScene) {
-  RunResult r = run_window("-t 2 -s 4 -r 64 48", "key L\nwait_spp 4\nkey S\nkey D\nsync\nquit\n");
-  int png = 0, rate = 0, exr = 0;
-  for (const std::string& f : files_in(m_dir)) {
+namespace {
+
+// The files S and D wrote into `dir`: screenshot PNG, rate PNG, EXR and camera settings counts.
+struct Written {
+  int png = 0, rate = 0, exr = 0, cam = 0;
+};
+Written written_in(const std::string& dir) {
+  Written w;
+  for (const std::string& f : files_in(dir)) {
+    if (f == "cornell_cam_settings.txt") ++w.cam;
     if (f.rfind("cornell_screenshot_", 0) != 0) continue;
-    if (ends_with(f, "_rate.png")) ++rate;
-    else if (ends_with(f, ".png")) ++png;
-    else if (ends_with(f, ".exr")) ++exr;
+    if (ends_with(f, "_rate.png")) ++w.rate;
+    else if (ends_with(f, ".png")) ++w.png;
+    else if (ends_with(f, ".exr")) ++w.exr;
   }
-  EXPECT_EQ(png, 1) << r.output;
-  EXPECT_EQ(rate, 1) << r.output;
-  EXPECT_EQ(exr, 1) << r.output;
-  std::ifstream cam(m_dir + "/cornell_cam_settings.txt");
+  return w;
+}
+
+}  // namespace
+
+// S and D write into the current directory, never next to the scene (its folder may be shared or
+// read-only), and the log names what was written.
+TEST_F(Viewer, SaveAndCameraKeysWriteToTheCurrentDirectory) {
+  const std::string cwd = m_dir + "/cwd";
+  mkdir(cwd.c_str(), 0755);
+  for (const std::string& f : files_in(cwd)) unlink((cwd + "/" + f).c_str());
+  RunResult r = run_window("-t 2 -s 4 -r 64 48", "key L\nwait_spp 4\nkey S\nkey D\nsync\nquit\n", cwd);
+  Written here = written_in(cwd), beside = written_in(m_dir);
+  EXPECT_EQ(here.png, 1) << r.output;
+  EXPECT_EQ(here.rate, 1) << r.output;
+  EXPECT_EQ(here.exr, 1) << r.output;
+  EXPECT_EQ(here.cam, 1) << r.output;
+  EXPECT_EQ(beside.png + beside.rate + beside.exr + beside.cam, 0) << "written next to the scene: " << r.output;
+  std::smatch m;
+  std::string saved = last_line_with(r.output, "saved ");
+  ASSERT_TRUE(std::regex_search(saved, m, std::regex(R"(saved (\S+\.png),)"))) << r.output;
+  EXPECT_EQ(access((cwd + "/" + std::string(m[1])).c_str(), F_OK), 0) << saved;
+  std::ifstream cam(cwd + "/cornell_cam_settings.txt");
   ASSERT_TRUE(cam) << r.output;
   std::vector<std::string> lines;
   for (std::string l; std::getline(cam, l);) lines.push_back(l);
@@ -327,9 +210,24 @@ TEST_F(Viewer, SaveAndCameraKeysWriteNextToTheScene) {
   EXPECT_EQ(lines[5], "4.7 0.05");  // focal distance, lens radius: as shown in the window
 }
 
+TEST_F(Viewer, OutputDirTakesTheSavedFiles) {
+  const std::string out = m_dir + "/shots", cwd = m_dir + "/cwd";
+  for (const std::string& d : {out, cwd}) {
+    mkdir(d.c_str(), 0755);
+    for (const std::string& f : files_in(d)) unlink((d + "/" + f).c_str());
+  }
+  RunResult r = run_window("-t 2 -s 4 -r 64 48 --output-dir " + out, "wait_spp 4\nkey S\nkey D\nsync\nquit\n", cwd);
+  Written there = written_in(out), here = written_in(cwd), beside = written_in(m_dir);
+  EXPECT_EQ(there.png + there.rate + there.exr + there.cam, 4) << r.output;
+  EXPECT_EQ(here.png + here.rate + here.exr + here.cam, 0) << r.output;
+  EXPECT_EQ(beside.png + beside.rate + beside.exr + beside.cam, 0) << r.output;
+  EXPECT_NE(last_line_with(r.output, "saved ").find("saved " + out + "/cornell_screenshot_"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("wrote " + out + "/cornell_cam_settings.txt"), std::string::npos) << r.output;
+}
+
 TEST_F(Viewer, ResizingRendersAtTheNewFramebufferSize) {
   RunResult r = run_window("-t 2 -s 4 -r 96 72 --seed 1",
-                           "wait_spp 4\nresize 64 48\nwait_spp 4\nscreenshot " + m_dir + "/small.png\nquit\n");
+                           "key `\nwait_spp 4\nresize 64 48\nwait_spp 4\nscreenshot " + m_dir + "/small.png\nquit\n");
   EXPECT_NE(r.output.find("size 64x48"), std::string::npos) << r.output;
   RunResult c = run("-t 2 -s 4 -r 64 48 --seed 1 --quiet -f " + m_dir + "/cli.png " + m_scene);
   ASSERT_EQ(c.status, 0) << c.output;

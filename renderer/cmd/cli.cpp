@@ -156,6 +156,11 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
       if (o.checkpoint.empty()) throw UsageError("--checkpoint: empty file name");
     } else if (a == "--checkpoint-interval") { need(a, 1); o.checkpoint_interval = parse_float(a, args[++i], 0, 1e9); }
     else if (a == "--script") { need(a, 1); o.script = args[++i]; }
+    else if (a == "--output-dir") {
+      need(a, 1);
+      o.output_dir = args[++i];
+      if (o.output_dir.empty()) throw UsageError("--output-dir: empty directory name");
+    }
     else if (a.size() > 1 && a[0] == '-') {
       const std::string near = nearest_option(a);
       throw UsageError("unknown option '" + a + "'" + (near.empty() ? "" : " (did you mean " + near + "?)"));
@@ -173,6 +178,8 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
   if (!spp_given && o.limits.target_error > 0) p.spp = int(render_option("spp").max);
   o.spp_given = spp_given;
   if (!o.checkpoint.empty() && o.output.empty()) throw UsageError("--checkpoint needs -f (the window keeps no checkpoint)");
+  if (!o.output_dir.empty() && !o.output.empty())
+    throw UsageError("--output-dir is for the window's S and D keys; -f names its own path");
   try {
     p.validate();
   } catch (const std::invalid_argument& e) {
@@ -233,9 +240,10 @@ std::string usage_text(const std::string& program) {
 "  --checkpoint <FILE>    save the render to FILE between passes; the same command run again\n"
 "                         continues it from there (the finished image is the same, bit for bit)\n"
 "  --checkpoint-interval <SEC>  seconds between checkpoints (default 30; 0 = after every pass)\n"
+"  --output-dir <DIR>  window only: where S and D write (default: the current directory)\n"
 "  --script <FILE> window only: replay input from FILE, one command a line (for tests):\n"
 "                  wait_spp N | wait_ms N | key K | click X Y | resize W H | sync |\n"
-"                  title | screenshot FILE.png | close | quit\n"
+"                  title | overlay | screenshot FILE.png | close | quit\n"
 "\n"
 "Window keys (without -f; the render restarts after each change):\n" + window_keys_text() +
 "  The render follows the window's size: -r gives the initial window size.\n";
@@ -249,11 +257,13 @@ std::string window_keys_text() {
 "  ' / ;           focal distance +0.1 / -0.1 (min 0): focal plane farther / nearer\n"
 "  ] / [           samples per pixel x2 / /2\n"
 "  = / -           light samples x2 / /2\n"
-"  T               toggle the sample-rate view\n"
+"  T               toggle the sample-rate view (with its colour legend)\n"
 "  S               save <scene>_screenshot_<M>-<D>_<h>-<m>-<s>.png, .exr and _rate.png\n"
-"  D               write the camera settings to <scene>_cam_settings.txt\n"
+"                  in the current directory (or --output-dir)\n"
+"  D               write the camera settings to <scene>_cam_settings.txt (there too)\n"
 "  click           focus the thin lens on the surface under the cursor (autofocus)\n"
-"  H               list these keys\n"
+"  `               show / hide the status panel (samples, error, ETA, settings)\n"
+"  H               list these keys (in the panel and on stdout)\n"
 "  Esc / Q         quit\n";
 }
 

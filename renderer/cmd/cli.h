@@ -18,6 +18,7 @@ struct CliOptions {
   bool spp_given = false;  // -s was on the command line (hints and the error target read it)
   bool quiet = false;      // --quiet: no progress bar
   std::string script;      // --script: window input replayed from a file (tests)
+  std::string output_dir;  // --output-dir: where the window's S and D keys write (empty: the current directory)
   bool describe = false;   // --describe: print the feature set and memory, no render
   std::string error_log;   // --error-log: CSV of the error per pass
   std::string progress_log;  // --progress-log: CSV of the progress bar's fraction and ETA
@@ -38,7 +39,7 @@ std::string usage_text(const std::string& program);
 // The options --help lists ("-s", "--keep-fov", ...), and the one nearest a mistyped one ("" if none is near).
 std::vector<std::string> cli_option_names();
 std::string nearest_option(const std::string& given);
-// The debug window's keys, one a line (part of usage_text; the window's H key prints it).
+// The debug window's keys, one a line (part of usage_text; the window's H key shows it).
 std::string window_keys_text();
 // The EXR header of a render: its parameters, achieved samples, wall time and error estimate.
 Metadata render_metadata(const CliOptions& options, const RenderSession& session);

@@ -5,23 +5,28 @@
 // its cancel flag and start a new session; the window thread never waits on rendering.
 // The render size follows the window's framebuffer (course behaviour); until the new session's
 // first tiles arrive the previous image is stretched to the new size.
-// --script replays window input from a file, so tests can drive the real window under Xvfb.
+// The status panel and the rate view's legend are drawn over the image (overlay.h); the title
+// keeps a short status for window managers. S and D write into --output-dir (default: the
+// current directory). --script replays window input from a file (viewer_script.h), so tests can
+// drive the real window under Xvfb.
 #include "viewer.h"
 
 #include <GLFW/glfw3.h>
+#include <sys/stat.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <thread>
 
+#include "overlay.h"
 #include "scene_file.h"
 #include "session.h"
 #include "viewer_loop.h"
+#include "viewer_script.h"
 
 namespace pt {
 
@@ -29,67 +34,11 @@ namespace {
 
 using namespace viewer;
 
-// ---- the script player ----
-
-struct ScriptLine {
-  int line;
-  std::vector<std::string> words;
-};
-
-int key_code(const std::string& name) {
-  if (name == "Esc" || name == "Escape" || name == "esc") return GLFW_KEY_ESCAPE;
-  if (name.size() != 1) return -1;
-  char c = name[0];
-  if (c >= 'a' && c <= 'z') return GLFW_KEY_A + (c - 'a');
-  if (c >= 'A' && c <= 'Z') return GLFW_KEY_A + (c - 'A');
-  switch (c) {
-    case '.': return GLFW_KEY_PERIOD;
-    case ',': return GLFW_KEY_COMMA;
-    case '\'': return GLFW_KEY_APOSTROPHE;
-    case ';': return GLFW_KEY_SEMICOLON;
-    case '[': return GLFW_KEY_LEFT_BRACKET;
-    case ']': return GLFW_KEY_RIGHT_BRACKET;
-    case '=': return GLFW_KEY_EQUAL;
-    case '-': return GLFW_KEY_MINUS;
-    default: return -1;
-  }
-}
-
-// Reads and checks the whole script up front; throws naming FILE:LINE.
-std::vector<ScriptLine> load_script(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open script");
-  std::vector<ScriptLine> out;
-  std::string text;
-  for (int n = 1; std::getline(in, text); ++n) {
-    std::istringstream ws(text);
-    ScriptLine l{n, {}};
-    for (std::string w; ws >> w;) l.words.push_back(w);
-    if (l.words.empty() || l.words[0][0] == '#') continue;
-    const std::string& c = l.words[0];
-    size_t want_args = c == "wait_spp" || c == "wait_ms" || c == "key" || c == "screenshot" ? 1
-                       : c == "click" || c == "resize"                                          ? 2
-                       : c == "sync" || c == "title" || c == "close" || c == "quit"             ? 0
-                                                                                                 : size_t(-1);
-    std::string where = path + ":" + std::to_string(n) + ": ";
-    if (want_args == size_t(-1)) throw std::runtime_error(where + "unknown command '" + c + "'");
-    if (l.words.size() != want_args + 1)
-      throw std::runtime_error(where + c + " takes " + std::to_string(want_args) + " argument(s)");
-    if (c == "key" && key_code(l.words[1]) < 0) throw std::runtime_error(where + "unknown key '" + l.words[1] + "'");
-    for (size_t i = 1; i < l.words.size() && c != "key" && c != "screenshot"; ++i) {
-      char* end = nullptr;
-      double v = std::strtod(l.words[i].c_str(), &end);
-      if (*end != '\0' || !(v >= 0)) throw std::runtime_error(where + "'" + l.words[i] + "' is not a number >= 0");
-    }
-    out.push_back(std::move(l));
-  }
-  return out;
-}
-
 // ---- the window thread ----
 
 constexpr double kScriptTimeoutMs = 120000;
 constexpr double kResizeSettleMs = 150;
+constexpr int kMinWindowW = 160, kMinWindowH = 120;
 
 class Viewer {
  public:
@@ -144,7 +93,7 @@ class Viewer {
       upload_tiles(st);  // after the status snapshot: a completed pass's tiles are all queued by then
       apply_resize();
       if (m_script_pos < m_script.size()) step_script(st);
-      if (m_dirty) {
+      if (m_dirty || panel_changed()) {
         draw();
         glfwSwapBuffers(m_win);
         m_dirty = false;
@@ -196,7 +145,7 @@ class Viewer {
   }
 
   void on_key(int key, bool repeat) {
-    if (key != GLFW_KEY_H) m_show_keys = false;
+    if (key != GLFW_KEY_H) set_show_keys(false);
     switch (key) {
       case GLFW_KEY_ESCAPE:
       case GLFW_KEY_Q: glfwSetWindowShouldClose(m_win, GLFW_TRUE); break;
@@ -247,12 +196,24 @@ class Viewer {
       case GLFW_KEY_S: push_command({CommandKind::save}); break;
       case GLFW_KEY_D: write_camera(); break;
       case GLFW_KEY_H:
-        m_show_keys = !m_show_keys;
-        std::printf("Window keys:\n%s", window_keys_text().c_str());
-        std::fflush(stdout);
+        set_show_keys(!m_show_keys);
+        if (m_show_keys) {
+          std::printf("Window keys:\n%s", window_keys_text().c_str());
+          std::fflush(stdout);
+        }
+        break;
+      case GLFW_KEY_GRAVE_ACCENT:  // the course's key for its on-screen info text
+        m_show_panel = !m_show_panel;
+        m_dirty = true;
+        say("panel: %s", m_show_panel ? "shown" : "hidden");
         break;
       default: break;
     }
+  }
+
+  void set_show_keys(bool on) {
+    m_dirty |= on != m_show_keys;
+    m_show_keys = on;
   }
 
   static std::string step_lens(RenderParams& p, float step) {
@@ -281,7 +242,7 @@ class Viewer {
       std::lock_guard<std::mutex> lk(m_sh.mutex);
       p = m_sh.want;
     }
-    std::string path = scene_base(m_options.scene_path) + "_cam_settings.txt";
+    std::string path = output_path(m_options, "_cam_settings.txt");
     try {
       write_camera_settings(make_camera(m_desc, camera_params(p)), path);
       say("wrote %s", path.c_str());
@@ -316,6 +277,7 @@ class Viewer {
         m_tex_h = st.height;
         m_rgb.assign(size_t(m_tex_w) * m_tex_h * 3, 0);
         m_rate.assign(m_rgb.size(), 0);
+        m_count.assign(size_t(m_tex_w) * m_tex_h, 0);
         glBindTexture(GL_TEXTURE_2D, m_tex);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -342,6 +304,7 @@ class Viewer {
         size_t dst = (size_t(y) * m_tex_w + t.x0) * 3, src = size_t(y - t.y0) * tw * 3;
         std::copy(u.rgb.begin() + src, u.rgb.begin() + src + tw * 3, m_rgb.begin() + dst);
         std::copy(u.rate.begin() + src, u.rate.begin() + src + tw * 3, m_rate.begin() + dst);
+        std::copy(u.count.begin() + src / 3, u.count.begin() + src / 3 + tw, m_count.begin() + dst / 3);
       }
       upload_rect(t.x0, t.y0, tw, t.y1 - t.y0);
     }
@@ -361,10 +324,18 @@ class Viewer {
 
   void upload_all() { upload_rect(0, 0, m_tex_w, m_tex_h); }
 
-  // The texture on a full-window quad; texture row 0 is the image's top row.
+  // The image, then the overlay.
   void draw() {
     int fw, fh;
     glfwGetFramebufferSize(m_win, &fw, &fh);
+    draw_image(fw, fh);
+    Overlay o = layout_overlay(overlay_inputs(), fw, fh);
+    draw_overlay(o, fw, fh);
+    m_panel_lines = o.panel_layout.lines;
+  }
+
+  // The texture on a full-window quad; texture row 0 is the image's top row.
+  void draw_image(int fw, int fh) {
     glViewport(0, 0, fw, fh);
     glClearColor(0, 0, 0, 1);
     glClear(GL_COLOR_BUFFER_BIT);
@@ -388,41 +359,52 @@ class Viewer {
     glDisable(GL_TEXTURE_2D);
   }
 
+  // What the overlay is drawn over and which of its parts are on.
+  OverlayInputs overlay_inputs() {
+    OverlayInputs in;
+    {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      in.status = m_sh.status;
+      in.params = m_sh.want;
+      in.current = in.status.gen == m_sh.want_gen;
+    }
+    in.show_panel = m_show_panel;
+    in.show_keys = m_show_keys;
+    in.show_rate = m_show_rate;
+    in.have_image = m_tex_w > 0;
+    if (m_show_rate && !m_count.empty()) {
+      auto [lo, hi] = std::minmax_element(m_count.begin(), m_count.end());
+      in.min_count = *lo;
+      in.max_count = *hi;
+    }
+    return in;
+  }
+
+  // The panel's text changes without new tiles: the ETA counts down, a key changes a setting.
+  bool panel_changed() {
+    int fw, fh;
+    glfwGetFramebufferSize(m_win, &fw, &fh);
+    return layout_overlay(overlay_inputs(), fw, fh).panel_layout.lines != m_panel_lines;
+  }
+
   void update_title(const Status& st) {
-    RenderParams p;
     bool current;
     {
       std::lock_guard<std::mutex> lk(m_sh.mutex);
-      p = m_sh.want;
       current = st.gen == m_sh.want_gen;
     }
     std::string name = m_options.scene_path.substr(m_options.scene_path.find_last_of('/') + 1);
-    char buf[512];
-    if (m_show_keys) {
-      std::snprintf(buf, sizeof buf,
-                    "keys: R restart | . , depth | L K lens | ' ; focus | ] [ spp | = - light samples | T rate view | "
-                    "S save | D camera | click autofocus | Esc/Q quit");
-    } else {
-      char spp[64];
-      if (current && st.finished)
-        std::snprintf(spp, sizeof spp, "%d/%d spp done", st.reached_spp, st.spp);
-      else if (current && st.eta >= 0)  // counted down since the pass that made it
-        std::snprintf(spp, sizeof spp, "%d/%d spp, %.0f%%, ETA %.0fs", st.reached_spp, st.spp, 100 * st.progress,
-                      std::max(0.0, st.eta - ms_since(st.at) / 1000));
-      else if (current)
-        std::snprintf(spp, sizeof spp, "%d/%d spp", st.reached_spp, st.spp);
-      else
-        std::snprintf(spp, sizeof spp, "restarting");
-      std::snprintf(buf, sizeof buf,
-                    "pathtracer: %s | %s | error %s | depth %d | lens %s | focus %s | light %d | %dx%d%s", name.c_str(),
-                    spp, format_error_estimate(current ? st.error : INFINITY).c_str(), p.max_depth,
-                    fmt_g(p.lens_radius).c_str(), fmt_g(p.focal_distance).c_str(), p.light_samples, p.width, p.height,
-                    m_show_rate ? " | rate view" : "");
+    std::string title = "pathtracer: " + name + " | " + progress_text(st, current);
+    if (m_title != title) {
+      m_title = title;
+      glfwSetWindowTitle(m_win, title.c_str());
     }
-    if (m_title != buf) {
-      m_title = buf;
-      glfwSetWindowTitle(m_win, buf);
-    }
+  }
+
+  void report_overlay() {
+    int fw, fh;
+    glfwGetFramebufferSize(m_win, &fw, &fh);
+    say("%s", overlay_report(layout_overlay(overlay_inputs(), fw, fh), fw, fh).c_str());
   }
 
   // Runs script commands until one has to wait; a failure closes the window with status 1.
@@ -457,6 +439,8 @@ class Viewer {
       } else if (c == "title") {
         update_title(st);
         say("title: %s", m_title.c_str());
+      } else if (c == "overlay") {
+        report_overlay();
       } else if (c == "screenshot") {
         screenshot(l.words[1]);
       } else if (c == "close" || c == "quit") {
@@ -506,7 +490,9 @@ class Viewer {
   int m_tex_w = 0, m_tex_h = 0;
   uint64_t m_tex_gen = 0;
   std::vector<uint8_t> m_rgb, m_rate;  // what the texture holds, for each view
-  bool m_show_rate = false, m_show_keys = false, m_dirty = true;
+  std::vector<uint32_t> m_count;       // samples in each pixel, for the rate legend
+  bool m_show_rate = false, m_show_keys = false, m_show_panel = true, m_dirty = true;
+  std::vector<std::string> m_panel_lines;  // as last drawn: the ETA counts down between passes
   int m_resize_w = 0, m_resize_h = 0;
   Clock::time_point m_resize_at;
   std::string m_title;
@@ -527,6 +513,11 @@ int run_viewer(const CliOptions& o) {
     if (!o.script.empty()) script = load_script(o.script);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pathtracer: %s\n", e.what());
+    return 1;
+  }
+  struct stat dir;
+  if (!o.output_dir.empty() && (stat(o.output_dir.c_str(), &dir) != 0 || !S_ISDIR(dir.st_mode))) {
+    std::fprintf(stderr, "pathtracer: --output-dir %s: not a directory\n", o.output_dir.c_str());
     return 1;
   }
   glfwSetErrorCallback([](int, const char* text) { g_glfw_error = text; });
@@ -552,6 +543,9 @@ int run_viewer(const CliOptions& o) {
       glfwTerminate();
       return 2;
     }
+    // The smallest window the status panel fits at its smallest text (or the -r size, if smaller).
+    glfwSetWindowSizeLimits(win, std::min(kMinWindowW, o.params.width), std::min(kMinWindowH, o.params.height),
+                            GLFW_DONT_CARE, GLFW_DONT_CARE);
     glfwMakeContextCurrent(win);
     glfwSwapInterval(0);
     {

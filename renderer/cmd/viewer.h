@@ -1,7 +1,8 @@
 // The GLFW debug window (`pathtracer scene.dae` without -f): the progressive render as it
-// converges, the course's render-mode keys, click-to-focus, and a script player for tests.
-// viewer.cpp is the only file that includes GLFW / OpenGL; it is linked into the pathtracer
-// executable only, never into the renderer library.
+// converges, a status panel and rate legend over it, the course's render-mode keys,
+// click-to-focus, and a script player for tests. viewer.cpp, viewer_script.cpp and overlay.cpp
+// are the only files that include GLFW / OpenGL; they are linked into the pathtracer executable
+// only, never into the renderer library.
 #pragma once
 
 #include "cli.h"

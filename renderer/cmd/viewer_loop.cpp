@@ -35,6 +35,13 @@ std::string scene_base(const std::string& path) {
   return path;
 }
 
+std::string output_path(const CliOptions& o, const std::string& suffix) {
+  std::string base = scene_base(o.scene_path);
+  base = base.substr(base.find_last_of('/') + 1);
+  if (o.output_dir.empty()) return base + suffix;
+  return o.output_dir + (o.output_dir.back() == '/' ? "" : "/") + base + suffix;
+}
+
 void RenderLoop::run() {
   try {
     loop();
@@ -130,7 +137,7 @@ void RenderLoop::start_session(const RenderParams& p, uint64_t gen) {
 }
 
 void RenderLoop::send_tile(uint64_t gen, const RenderSession& s, const Tile& t) {
-  TileUpdate u{gen, t, {}, {}};
+  TileUpdate u{gen, t, {}, {}, {}};
   std::vector<Vec3> px;
   s.film().read_tile(t, px);
   u.rgb.resize(px.size() * 3);
@@ -140,6 +147,7 @@ void RenderLoop::send_tile(uint64_t gen, const RenderSession& s, const Tile& t) 
   u.rate.resize(px.size() * 3);
   for (size_t i = 0; i < px.size(); ++i)
     for (int c = 0; c < 3; ++c) u.rate[3 * i + c] = tonemap_course(px[i][c]);  // as the _rate.png
+  s.film().read_tile_count(t, u.count);
   bool was_empty;
   {
     std::lock_guard<std::mutex> lk(m_sh.tile_mutex);
@@ -172,7 +180,7 @@ float RenderLoop::handle(const Command& c, const RenderParams& want) {
   char stamp[64];
   std::snprintf(stamp, sizeof stamp, "_screenshot_%d-%d_%d-%d-%d", lt.tm_mon + 1, lt.tm_mday, lt.tm_hour, lt.tm_min,
                 lt.tm_sec);
-  std::string base = scene_base(m_options.scene_path) + stamp;
+  std::string base = output_path(m_options, stamp);
   CliOptions o = m_options;
   o.params = m_params;
   try {

@@ -32,6 +32,9 @@ void say(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 std::string fmt_g(double v);
 // The scene path without ".dae" (or ".gltf", ".glb"): the course names screenshots and camera files after it.
 std::string scene_base(const std::string& path);
+// Where the window writes a file named after the scene: --output-dir (default: the current
+// directory), the scene's file name without its extension, then `suffix`.
+std::string output_path(const CliOptions& o, const std::string& suffix);
 
 // ---- state shared by the window thread and the render thread ----
 
@@ -39,6 +42,7 @@ struct TileUpdate {
   uint64_t gen;
   Tile tile;
   std::vector<uint8_t> rgb, rate;  // tone-mapped radiance and the rate colouring, 3 bytes a pixel
+  std::vector<uint32_t> count;     // samples taken in each pixel
 };
 
 // What the render thread reports about the session it runs.

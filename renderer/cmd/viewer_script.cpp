@@ -1,0 +1,65 @@
+// The window's --script player (viewer_script.h).
+#include "viewer_script.h"
+
+#include <GLFW/glfw3.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace pt {
+namespace viewer {
+
+int key_code(const std::string& name) {
+  if (name == "Esc" || name == "Escape" || name == "esc") return GLFW_KEY_ESCAPE;
+  if (name.size() != 1) return -1;
+  char c = name[0];
+  if (c >= 'a' && c <= 'z') return GLFW_KEY_A + (c - 'a');
+  if (c >= 'A' && c <= 'Z') return GLFW_KEY_A + (c - 'A');
+  switch (c) {
+    case '.': return GLFW_KEY_PERIOD;
+    case ',': return GLFW_KEY_COMMA;
+    case '\'': return GLFW_KEY_APOSTROPHE;
+    case ';': return GLFW_KEY_SEMICOLON;
+    case '[': return GLFW_KEY_LEFT_BRACKET;
+    case ']': return GLFW_KEY_RIGHT_BRACKET;
+    case '=': return GLFW_KEY_EQUAL;
+    case '-': return GLFW_KEY_MINUS;
+    case '`': return GLFW_KEY_GRAVE_ACCENT;
+    default: return -1;
+  }
+}
+
+std::vector<ScriptLine> load_script(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open script");
+  std::vector<ScriptLine> out;
+  std::string text;
+  for (int n = 1; std::getline(in, text); ++n) {
+    std::istringstream ws(text);
+    ScriptLine l{n, {}};
+    for (std::string w; ws >> w;) l.words.push_back(w);
+    if (l.words.empty() || l.words[0][0] == '#') continue;
+    const std::string& c = l.words[0];
+    size_t want_args = c == "wait_spp" || c == "wait_ms" || c == "key" || c == "screenshot"             ? 1
+                       : c == "click" || c == "resize"                                                      ? 2
+                       : c == "sync" || c == "title" || c == "overlay" || c == "close" || c == "quit" ? 0
+                                                                                                            : size_t(-1);
+    std::string where = path + ":" + std::to_string(n) + ": ";
+    if (want_args == size_t(-1)) throw std::runtime_error(where + "unknown command '" + c + "'");
+    if (l.words.size() != want_args + 1)
+      throw std::runtime_error(where + c + " takes " + std::to_string(want_args) + " argument(s)");
+    if (c == "key" && key_code(l.words[1]) < 0) throw std::runtime_error(where + "unknown key '" + l.words[1] + "'");
+    for (size_t i = 1; i < l.words.size() && c != "key" && c != "screenshot"; ++i) {
+      char* end = nullptr;
+      double v = std::strtod(l.words[i].c_str(), &end);
+      if (*end != '\0' || !(v >= 0)) throw std::runtime_error(where + "'" + l.words[i] + "' is not a number >= 0");
+    }
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+}  // namespace viewer
+}  // namespace pt
