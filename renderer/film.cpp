@@ -264,6 +264,12 @@ void Film::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const {
     for (int x = t.x0; x < t.x1; ++x) out.push_back(rate_colour(m_count[size_t(y) * m_w + x], m_spp));
 }
 
+void Film::read_tile_count(const Tile& t, std::vector<uint32_t>& out) const {
+  out.clear();
+  for (int y = t.y0; y < t.y1; ++y)
+    out.insert(out.end(), m_count.begin() + size_t(y) * m_w + t.x0, m_count.begin() + size_t(y) * m_w + t.x1);
+}
+
 double Film::error_estimate(int threads) const {
   return m_estimate.get([this, threads] {
     return halves_error_estimate(m_w, m_count, m_half_n, m_s1, m_half_s1,
