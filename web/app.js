@@ -271,8 +271,15 @@ function showError(field, message) {
     const details = line.closest('details');
     if (details) details.open = true;
   } else {
-    $('#err-form').textContent = message;
+    const form = $('#err-form');
+    form.textContent = form.textContent ? `${form.textContent} ${message}` : message;
   }
+}
+
+// Marks every field an error answer names (all of error.errors, else error.field).
+function showApiErrors(e, prefix = '') {
+  const list = e.errors && e.errors.length ? e.errors : [{ field: e.field, message: e.message }];
+  for (const x of list) showError(x.field, prefix + x.message);
 }
 
 function showClientErrors(errors) {
@@ -300,8 +307,7 @@ async function checkForm() {
     const n = new Intl.NumberFormat('en', { notation: 'compact', maximumFractionDigits: 1 }).format(s.width * s.height * s.spp);
     $('#check-state').textContent = `✓ ${n} samples`;
   } else {
-    const e = apiError(r);
-    showError(e.field, e.message);
+    showApiErrors(apiError(r));
   }
 }
 
@@ -318,8 +324,7 @@ async function submitJob(ev) {
     const r = await postJson('/api/jobs', spec, { 'Idempotency-Key': randomKey() });
     clearErrors();
     if (!r || !r.ok) {
-      const e = apiError(r);
-      showError(e.field, e.message);
+      showApiErrors(apiError(r));
       return;
     }
     viewer.show(r.data.id);

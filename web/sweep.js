@@ -41,15 +41,13 @@ async function runSweep(kind) {
   try {
     const first = await postJson('/api/jobs/check', { ...base, [key]: values[0] });
     if (!first || !first.ok) {
-      const e = apiError(first);
-      return showError(e.field, e.message);
+      return showApiErrors(apiError(first));
     }
     const ids = [];
     for (const v of values) {
       const r = await postJson('/api/jobs', { ...base, [key]: v }, { 'Idempotency-Key': randomKey() });
       if (!r || !r.ok) {
-        const e = apiError(r);
-        showError(e.field, `Sweep stopped after ${ids.length} of 4 jobs: ${e.message}`);
+        showApiErrors(apiError(r), `Sweep stopped after ${ids.length} of 4 jobs: `);
         break;
       }
       ids.push({ id: r.data.id, label: `${key === 'aperture' ? 'aperture' : 'focus'} ${v}` });
