@@ -1,8 +1,8 @@
 // The render-job page: a form that validates against /api/jobs/check, a viewer fed by the job's
 // event stream (tiles paint as they arrive), click-to-focus, and the wiring. No framework, no
-// build step: common.js (state, API), feed.js (a job's event stream), chart.js, sweep.js and
-// jobs.js (the job list) load before this file (index.html), as plain scripts sharing their
-// top-level names.
+// build step: common.js (state, API), feed.js (a job's event stream), chart.js, sweep.js, jobs.js
+// (the job list), viewer_tools.js (exposure, mappings, zoom, readout) and compare.js load before
+// this file (index.html), as plain scripts sharing their top-level names.
 'use strict';
 
 // Form fields: name -> kind. The input of field F is #f-F and its error line is #err-F.
@@ -32,6 +32,7 @@ const viewer = {
     this.feed = null;
     this.fillPending = fill;
     this.moreFor = null;
+    tools.reset();
     $('#v-marker').hidden = true;
     this.note('');
     history.replaceState(null, '', id ? `#job=${id}` : '#');
@@ -70,11 +71,13 @@ const viewer = {
       clearCanvas(canvas, feed.canvas.width, feed.canvas.height);
       fitStage();
     } else if (type === 'pixels') {
-      syncCanvas(canvas, feed, rect);
+      if (!tools.active()) syncCanvas(canvas, feed, rect);  // else the tools paint from the float pixels
+      tools.onPixels(feed.ended);
       $('#v-placeholder').hidden = true;
       $('#viewer').dataset.tiles = String(feed.tiles);
     } else if (type === 'status') {
       this.renderStatus(feed.status);
+      if (tools.rate) tools.showLegend();
     } else if (type === 'conn') {
       $('#viewer').dataset.conn = feed.conn;
     } else if (type === 'history') {
@@ -83,6 +86,7 @@ const viewer = {
       $('#viewer').dataset.ended = 'false';
     } else if (type === 'end') {
       $('#viewer').dataset.ended = 'true';
+      if (feed.painted) tools.onPixels(true);
       const st = feed.status && feed.status.state;
       if (!feed.painted) {
         $('#v-placeholder').textContent = st === 'cancelled' ? 'No image: the job was cancelled.'
@@ -185,6 +189,7 @@ function fitStage() {
   requestAnimationFrame(() => {
     const scale = wrap.clientWidth / w;
     canvas.style.imageRendering = scale >= 2 ? 'pixelated' : 'auto';
+    tools.applyZoom();
   });
 }
 
@@ -201,8 +206,9 @@ async function focusAt(ev) {
   const px = Math.min(canvas.width - 1, Math.floor(fx * canvas.width)) + 0.5;
   const py = Math.min(canvas.height - 1, Math.floor(fy * canvas.height)) + 0.5;
   const marker = $('#v-marker');
-  marker.style.left = `${fx * 100}%`;
-  marker.style.top = `${fy * 100}%`;
+  const wrap = $('#v-wrap').getBoundingClientRect();  // the canvas may be zoomed and panned inside it
+  marker.style.left = `${((ev.clientX - wrap.left) / wrap.width) * 100}%`;
+  marker.style.top = `${((ev.clientY - wrap.top) / wrap.height) * 100}%`;
   marker.hidden = false;
   marker.classList.remove('pulse');
   void marker.offsetWidth;
@@ -439,6 +445,8 @@ function init() {
   });
   initJobs();
   initUpload();
+  initViewerTools();
+  initCompare();
   let resizeTimer = null;
   window.addEventListener('resize', () => {
     clearTimeout(resizeTimer);

@@ -67,7 +67,8 @@ function rowFor(id) {
     '<button type="button" data-action="pause">Pause</button><button type="button" data-action="resume">Resume</button>' +
     '<button type="button" data-action="cancel" class="danger">Cancel</button>' +
     '<button type="button" data-action="delete" class="danger" title="Delete the job and its images">Delete</button>' +
-    '<a class="button" data-action="png">PNG</a><a class="button" data-action="exr">EXR</a></td>';
+    '<a class="button" data-action="png">PNG</a><a class="button" data-action="exr">EXR</a>' +
+    '<label class="compare-pick" title="Compare two jobs: the first picked is A"><input type="checkbox" data-action="compare"> compare</label></td>';
   jobList.rows.set(id, tr);
   return tr;
 }
@@ -112,6 +113,7 @@ function renderJobs(jobs) {
     if (!seen.has(id)) { tr.remove(); jobList.rows.delete(id); }
   }
   markDifferences(jobs);
+  syncComparePicks();
   $('#jobs-empty').hidden = jobs.length > 0;
   $('#jobs-more').hidden = !jobList.more;
   highlightRow();
@@ -244,7 +246,7 @@ function onReconnected() {
 function initJobs() {
   $('#job-rows').addEventListener('click', (e) => {
     const b = e.target.closest('[data-action]');
-    if (!b || b.tagName === 'A') return;
+    if (!b || b.tagName === 'A' || b.tagName === 'INPUT') return;  // links; compare boxes: compare.js
     const id = b.closest('tr').dataset.id;
     if (b.dataset.action === 'open') viewer.show(id, { fill: true });
     else if (b.dataset.action === 'delete') armDelete(b, id);

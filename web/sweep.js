@@ -67,7 +67,8 @@ class SweepCell {
     this.el.dataset.id = id;
     this.el.dataset.state = 'queued';
     this.el.innerHTML = '<button type="button" class="cell-open" title="Open in the viewer"><canvas></canvas></button>' +
-      '<figcaption><span class="cell-label"></span><span class="cell-state"></span></figcaption>' +
+      '<figcaption><span class="cell-label"></span><span class="cell-state"></span>' +
+      '<label class="compare-pick"><input type="checkbox" data-action="compare"> compare</label></figcaption>' +
       '<div class="progress mini"><div class="bar"></div></div>';
     this.canvas = this.el.querySelector('canvas');
     this.el.querySelector('.cell-label').textContent = label;
@@ -101,6 +102,7 @@ function showSweep(title, sub, jobs) {
   const grid = $('#sweep-grid');
   state.sweepCells = jobs.map((j) => new SweepCell(j.id, j.label));
   state.sweepCells.forEach((c) => grid.appendChild(c.el));
+  syncComparePicks();
   $('#sweep').hidden = false;
   $('#sweep').scrollIntoView({ behavior: 'smooth', block: 'nearest' });
 }
