@@ -78,7 +78,33 @@ void read_settings_file(Camera& c, const std::string& path) {
   }
 }
 
+// The projected bounding box on the image plane at unit depth: x and y extents in tangent units
+// (x along right, y along up), from the corners in front of the camera. False when none is.
+bool projected_bounds(const Camera& c, const Bounds3& b, float& x0, float& x1, float& y0, float& y1) {
+  if (b.empty()) return false;
+  x0 = y0 = kInf, x1 = y1 = -kInf;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner((i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z);
+    const Vec3 d = corner - c.position;
+    const float z = -dot(d, c.back);
+    if (!(z > 1e-6f * length(d))) return false;  // a corner at or behind the camera: no finite fit
+    const float x = dot(d, c.right) / z, y = dot(d, c.up) / z;
+    x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  }
+  return std::isfinite(x0 + x1 + y0 + y1);
+}
+
 }  // namespace
+
+float visible_bounds_fraction(const Camera& c, const Bounds3& b) {
+  float x0, x1, y0, y1;
+  if (!projected_bounds(c, b, x0, x1, y0, y1)) return 0;
+  const float area = (x1 - x0) * (y1 - y0);
+  if (!(area > 0)) return 1;
+  const float w = std::max(0.0f, std::min(x1, c.tan_half_w) - std::max(x0, -c.tan_half_w));
+  const float h = std::max(0.0f, std::min(y1, c.tan_half_h) - std::max(y0, -c.tan_half_h));
+  return std::min(1.0f, w * h / area);
+}
 
 Camera make_camera(const SceneDesc& scene, const CameraParams& p) {
   return make_camera(scene.camera, scene.geometry_bounds(), p);
@@ -132,9 +158,18 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
     set_basis(c, dir, Vec3(0, 1, 0));
   }
   // Resizing keeps the angle of a pixel: the FOV follows the output size (course behaviour).
-  // keep_fov instead scales the course's 800-pixel-wide view to the output width.
-  if (p.keep_fov && p.settings_file.empty() && !p.file_camera && !(authored.as_authored && authored.present))
+  // keep_fov instead scales the course's 800-pixel-wide view to the output width; frame_scene
+  // keeps the course's view direction and fits the field of view to the projected bounds (the
+  // view looks at their centre, so a symmetric fit wastes little), with a 2% margin.
+  const bool course_framing = p.settings_file.empty() && !p.file_camera && !(authored.as_authored && authored.present);
+  float x0, x1, y0, y1;
+  if (course_framing && p.frame_scene && projected_bounds(c, b, x0, x1, y0, y1)) {
+    const float need_x = 1.02f * std::max(-x0, x1), need_y = 1.02f * std::max(-y0, y1);
+    const float fit = std::min(need_x > 0 ? 0.5f * p.width / need_x : kInf, need_y > 0 ? 0.5f * p.height / need_y : kInf);
+    if (std::isfinite(fit) && fit > 0) c.screen_distance = fit;
+  } else if (course_framing && p.keep_fov) {
     c.screen_distance *= float(p.width) / 800.0f;
+  }
   c.tan_half_w = (0.5f * p.width) / c.screen_distance;
   c.tan_half_h = (0.5f * p.height) / c.screen_distance;
   return c;

@@ -19,6 +19,7 @@ struct CameraParams {
   float focal_distance = float(kCourseFocalDistance);  // -d: plane of focus, world units along the view axis
   bool file_camera = false;        // use the scene file's camera pose and FOV as authored
   bool keep_fov = false;           // -r scales the course's 800x600 view instead of cropping it
+  bool frame_scene = false;        // the course's view direction, the field of view fitted to the bounds
   std::string settings_file;       // -c: course camera settings file
 };
 
@@ -56,6 +57,9 @@ Camera make_camera(const SceneDesc& scene, const CameraParams& params);
 // The same from what the camera reads of a scene: the file's camera and the geometry bounds (the
 // course framing orbits them), so a view can be made without the scene's vertices.
 Camera make_camera(const CameraDesc& authored, const Bounds3& bounds, const CameraParams& params);
+// The fraction of the scene's bounding box, as the camera projects it, that the image shows
+// (1: all of it; 0 for empty bounds or bounds behind the camera). The CLI's crop hint reads it.
+float visible_bounds_fraction(const Camera& camera, const Bounds3& bounds);
 // Writes the course's six-line camera settings file (the window's D key).
 void write_camera_settings(const Camera& camera, const std::string& path);
 

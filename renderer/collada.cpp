@@ -27,22 +27,33 @@ SceneDesc Reader::read() {
   }
   pugi::xml_node root = m_doc.document_element();
   if (std::string(root.name()) != "COLLADA")
-    fail(root, "the root element must be <COLLADA>");
+    fail(root, "not a COLLADA scene: the root element is <" + clip(root.name()) + ">, not <COLLADA>");
   m_scene.source = m_name;
 
   // Every element with an id can be referenced by url="#id".
   // Iterative walk (documents can nest deeply; recursion depth is bounded by pugixml's own parse).
+  // With duplicate ids, references reach the first in document order (the walk visits children in
+  // reverse, so later nodes are replaced by earlier ones).
   std::vector<pugi::xml_node> stack{root};
-  if (auto id = root.attribute("id")) m_ids.emplace(id.value(), root);
+  std::vector<pugi::xml_node> with_id;
   while (!stack.empty()) {
     pugi::xml_node n = stack.back();
     stack.pop_back();
-    for (pugi::xml_node c = n.first_child(); c; c = c.next_sibling()) {
-      if (c.type() != pugi::node_element) continue;
-      if (auto id = c.attribute("id")) m_ids.emplace(id.value(), c);
-      stack.push_back(c);
-    }
+    if (n.attribute("id")) with_id.push_back(n);
+    for (pugi::xml_node c = n.last_child(); c; c = c.previous_sibling())
+      if (c.type() == pugi::node_element) stack.push_back(c);
   }
+  for (const pugi::xml_node& n : with_id) {
+    auto [it, fresh] = m_ids.emplace(n.attribute("id").value(), n);
+    if (!fresh) warn(n, "duplicate id '" + clip(n.attribute("id").value()) + "': references reach the first, " + where(it->second));
+  }
+  // Parts of COLLADA the renderer has no use for: said once each, not silently dropped.
+  for (const char* lib : {"library_animations", "library_controllers", "library_physics_scenes"})
+    if (pugi::xml_node l = root.child(lib))
+      if (l.first_child()) warn(l, std::string("<") + lib + "> is ignored (" +
+                                   (lib[8] == 'a' ? "animations are not rendered: the scene as posed"
+                                    : lib[8] == 'c' ? "skins and morphs: their meshes are not rendered"
+                                                    : "physics is not simulated") + ")");
 
   // Up axis: the world is Y-up internally (course mapping, see cs184-spec).
   m_up = Mat4::identity();
@@ -76,8 +87,13 @@ SceneDesc Reader::read() {
 
   if (m_scene.meshes.empty() && m_scene.spheres.empty() && m_scene.lights.empty())
     fail(vs, "the scene has no geometry and no lights");
-  if (m_warnings > m_limits.max_warnings)
-    std::fprintf(stderr, "warning: %s: %d more warnings not shown\n", m_name.c_str(), m_warnings - m_limits.max_warnings);
+  if (!m_scene.camera.present)
+    warn(vs, "no <instance_camera>: the course framing looks along -Z at the scene's bounding box");
+  m_scene.warnings = std::move(m_warning_lines);
+  if (m_warnings > m_limits.max_warnings) {
+    m_scene.warnings.push_back(m_name + ": " + std::to_string(m_warnings - m_limits.max_warnings) + " more warnings not shown");
+    std::fprintf(stderr, "warning: %s\n", m_scene.warnings.back().c_str());
+  }
   return std::move(m_scene);
 }
 
@@ -151,6 +167,7 @@ void Reader::read_node(const pugi::xml_node& node, const Mat4& parent, int depth
     } else if (tag == "instance_camera") read_camera(c, world);
     else if (tag == "instance_light") read_light(c, world);
     else if (tag == "instance_geometry") read_geometry(c, world);
+    else if (tag == "instance_controller") warn(c, "<instance_controller> (a skinned or morphed mesh) is not rendered");
   }
 }
 
@@ -267,6 +284,7 @@ Material Reader::read_effect(const pugi::xml_node& effect, const std::string& na
   bool found = false;
   // The last recognised CGL child defines the BSDF, as in the course parser.
   for (pugi::xml_node c = cgl.first_child(); c; c = c.next_sibling()) {
+    if (c.type() != pugi::node_element) continue;
     std::string tag = c.name();
     Material n;
     n.name = name;
@@ -289,6 +307,7 @@ Material Reader::read_effect(const pugi::xml_node& effect, const std::string& na
       n.k = color(c, "k");
       if (!(n.alpha > 0)) fail(c.child("alpha"), "alpha must be positive");
     } else {
+      warn(c, "<" + clip(tag) + "> is not a CGL material (emission, mirror, glass, refraction, microfacet): skipped");
       continue;
     }
     m = n;
@@ -303,8 +322,13 @@ Material Reader::read_effect(const pugi::xml_node& effect, const std::string& na
         m.albedo = color(d, "color");
         return m;
       }
+      if (d && d.child("texture")) {
+        warn(d, "a diffuse texture is not read from COLLADA: rendered as the default 0.5 grey diffuse");
+        return m;
+      }
     }
   }
+  warn(effect, "no CGL material and no phong, lambert or blinn diffuse colour: rendered as the default 0.5 grey diffuse");
   return m;
 }
 

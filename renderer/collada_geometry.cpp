@@ -114,7 +114,15 @@ void Reader::read_mesh(const pugi::xml_node& mesh, const pugi::xml_node& inst, c
     if (auto sym = prim.attribute("material")) {
       auto it = bound.find(sym.value());
       if (it != bound.end()) material = it->second;
+      else warn(prim, "material symbol '" + clip(sym.value()) + "' is not bound by an <instance_material>: " +
+                (first_bound >= 0 ? "the first bound material is used" : "rendered as the default 0.5 grey diffuse"));
     }
+    // A count that disagrees with the data: the data is rendered, and the disagreement said.
+    auto check_count = [&](size_t found) {
+      if (auto count = prim.attribute("count"))
+        if (count.as_ullong() != found)
+          warn(prim, "count says " + clip(count.value()) + " but the data holds " + std::to_string(found) + "; the data is used");
+    };
     std::vector<uint32_t> poly;
     auto vertex_indices = [&](const pugi::xml_node& p) {
       std::vector<uint32_t> all = indices(p);
@@ -137,6 +145,7 @@ void Reader::read_mesh(const pugi::xml_node& mesh, const pugi::xml_node& inst, c
       }
       if (total != v.size())
         fail(p, "<vcount> sums to " + std::to_string(total) + " vertices but <p> holds " + std::to_string(v.size()));
+      check_count(counts.size());
       size_t at = 0;
       for (uint32_t c : counts) {
         add_polygon(v.data() + at, c, material, p);
@@ -147,6 +156,7 @@ void Reader::read_mesh(const pugi::xml_node& mesh, const pugi::xml_node& inst, c
       if (!p) fail(prim, "missing <p>");
       std::vector<uint32_t> v = vertex_indices(p);
       if (v.size() % 3 != 0) fail(p, "triangle list length is not a multiple of 3");
+      check_count(v.size() / 3);
       for (size_t i = 0; i < v.size(); i += 3) add_polygon(v.data() + i, 3, material, p);
     } else {  // polygons: one <p> per polygon; <ph> holes keep their outer ring
       for (pugi::xml_node c = prim.first_child(); c; c = c.next_sibling()) {

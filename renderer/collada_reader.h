@@ -63,7 +63,8 @@ class Reader {
   // also costs a scan of the text).
   void warn(const pugi::xml_node& node, const std::string& msg) const {
     if (++m_warnings > m_limits.max_warnings) return;
-    std::fprintf(stderr, "warning: %s: %s\n", where(node).c_str(), msg.c_str());
+    m_warning_lines.push_back(where(node) + ": " + msg);
+    std::fprintf(stderr, "warning: %s\n", m_warning_lines.back().c_str());
   }
   // Every number and index read counts, again when instancing reads an array again: instancing
   // cannot multiply the work without bound.
@@ -159,6 +160,7 @@ class Reader {
   size_t m_triangle_count = 0;
   mutable size_t m_values = 0;
   mutable int m_warnings = 0;
+  mutable std::vector<std::string> m_warning_lines;
   SceneDesc m_scene;
   Mat4 m_up;
 };

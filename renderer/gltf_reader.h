@@ -38,6 +38,7 @@ struct Context {
   bool binary = false;
   mutable std::set<std::string> warned;
   mutable int warnings = 0;
+  mutable std::vector<std::string> lines;
 
   [[noreturn]] void fail(const std::string& path, const std::string& msg) const {
     throw SceneError(name + ": " + (path.empty() ? "/" : path) + ": " + msg);
@@ -46,11 +47,17 @@ struct Context {
   void warn(const std::string& kind, const std::string& path, const std::string& msg) const {
     if (!warned.insert(kind).second) return;
     if (++warnings > limits.max_warnings) return;
-    std::fprintf(stderr, "warning: %s: %s: %s\n", name.c_str(), path.empty() ? "/" : path.c_str(), msg.c_str());
+    lines.push_back(name + ": " + (path.empty() ? "/" : path) + ": " + msg);
+    std::fprintf(stderr, "warning: %s\n", lines.back().c_str());
   }
-  void summarize_warnings() const {
-    if (warnings > limits.max_warnings)
-      std::fprintf(stderr, "warning: %s: %d more warnings not shown\n", name.c_str(), warnings - limits.max_warnings);
+  // The warnings, and a line counting those over the cap.
+  std::vector<std::string> take_warnings() const {
+    std::vector<std::string> out = std::move(lines);
+    if (warnings > limits.max_warnings) {
+      out.push_back(name + ": " + std::to_string(warnings - limits.max_warnings) + " more warnings not shown");
+      std::fprintf(stderr, "warning: %s\n", out.back().c_str());
+    }
+    return out;
   }
 };
 

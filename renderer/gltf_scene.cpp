@@ -364,7 +364,7 @@ SceneDesc parse_gltf(const std::string& bytes, const std::string& name, bool bin
   Images images;
   tinygltf::Model model = run_tinygltf(ctx, bytes, parts, checked, images);
   SceneDesc desc = build_scene(ctx, model, images);
-  ctx.summarize_warnings();
+  desc.warnings = ctx.take_warnings();
   return desc;
 }
 

@@ -27,6 +27,7 @@ void RenderParams::validate() const {
               option_text(o, o.min) + " and " + option_text(o, o.max));
   }
   if (threads < 1 || threads > 1024) bad("threads (-t)", "must be between 1 and 1024");
+  if (keep_fov && frame_scene) bad("frame_scene (--frame-scene)", "and keep_fov (--keep-fov) are two framings: choose one");
   if (cell_w != 0 || cell_h != 0) {
     if (cell_w < 1 || cell_h < 1 || cell_x < 0 || cell_y < 0 || cell_x + cell_w > width || cell_y + cell_h > height)
       bad("cell (-p)", "x y dx dy must lie inside the " + std::to_string(width) + "x" + std::to_string(height) + " frame");
@@ -41,6 +42,7 @@ CameraParams camera_params(const RenderParams& params) {
   cp.focal_distance = params.focal_distance;
   cp.file_camera = params.file_camera;
   cp.keep_fov = params.keep_fov;
+  cp.frame_scene = params.frame_scene;
   cp.settings_file = params.camera_file;
   return cp;
 }
@@ -315,7 +317,11 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
 float autofocus_distance(const RenderScene& scene, float sx, float sy) {
   Ray r = scene.camera.pinhole_ray(sx, sy);
   SurfaceHit hit;
-  return scene.accel->intersect(r, hit) ? hit.t : kInf;
+  if (!scene.accel->intersect(r, hit)) return kInf;
+  // The thin lens focuses on a plane at a depth along the view axis, not at a distance along the
+  // ray: an off-centre hit's distance would put the plane behind it by 1 / cos of the ray's angle.
+  const float depth = dot(r.d * hit.t, -scene.camera.back);
+  return depth > 0 ? depth : kInf;
 }
 
 }  // namespace pt

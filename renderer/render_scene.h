@@ -116,8 +116,9 @@ std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams
 // The camera part of the render options (what make_render_scene passes to make_camera).
 CameraParams camera_params(const RenderParams& params);
 
-// Distance along the pinhole ray through sensor point (sx, sy) (y up) to the first surface, or
-// infinity: what autofocus sets the focal distance to, as in the course.
+// Depth along the view axis of the first surface the pinhole ray through sensor point (sx, sy)
+// (y up) meets, or infinity: what autofocus sets the focal distance to (the course sets the distance
+// along the ray, which focuses an off-centre click too far; docs/cs184-compat.md).
 float autofocus_distance(const RenderScene& scene, float sx, float sy);
 
 }  // namespace pt

@@ -99,6 +99,10 @@ struct SceneDesc {
   // glTF: without lights and emitters the render adds a uniform white environment (as glTF viewers
   // light such a scene; the course renders it black); RenderParams::default_light turns it off.
   bool default_light = false;
+  // What the loader ignored or defaulted, one line each ("file: where: what"), capped by
+  // LoadLimits::max_warnings with a last line counting the rest. The loaders also print them to
+  // stderr ("warning: ..."); the job service shows them with the scene and its jobs.
+  std::vector<std::string> warnings;
 
   size_t triangle_count() const;
   // Bounds of all meshes and spheres (lights excluded), as the course's camera framing uses.

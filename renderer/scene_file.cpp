@@ -19,6 +19,27 @@ bool has_extension(const std::string& name, const char* ext) {
   return true;
 }
 
+// What a file that is no scene looks like, by its first bytes, for the message.
+std::string what_it_is(const std::string& bytes) {
+  static const struct { const char* magic; size_t size; const char* kind; } kMagic[] = {
+      {"\x89PNG", 4, "a PNG image"},      {"\xFF\xD8\xFF", 3, "a JPEG image"},
+      {"\x76\x2F\x31\x01", 4, "an OpenEXR image"}, {"PK\x03\x04", 4, "a ZIP archive"},
+      {"\x1F\x8B", 2, "a gzip file"},      {"%PDF", 4, "a PDF document"},
+      {"\x7F" "ELF", 4, "a program"}};
+  for (const auto& m : kMagic)
+    if (bytes.size() >= m.size && bytes.compare(0, m.size, m.magic, m.size) == 0) return m.kind;
+  if (bytes.empty()) return "an empty file";
+  return "";
+}
+
+// COLLADA is XML: after a byte order mark and white space, its first character is '<'.
+bool looks_like_xml(const std::string& bytes) {
+  size_t i = bytes.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  if (bytes.compare(0, 2, "\xFF\xFE") == 0 || bytes.compare(0, 2, "\xFE\xFF") == 0) return true;  // UTF-16
+  while (i < bytes.size() && std::isspace((unsigned char)bytes[i])) ++i;
+  return i < bytes.size() && bytes[i] == '<';
+}
+
 std::string folder_of(const std::string& path) {
   size_t slash = path.find_last_of('/');
   if (slash == std::string::npos) return ".";
@@ -67,14 +88,28 @@ std::string read_scene_bytes(const std::string& path, const LoadLimits& limits) 
   return bytes;
 }
 
-SceneDesc parse_scene(const std::string& bytes, const std::string& name, const LoadLimits& limits,
-                      const std::string& base_dir) {
+namespace {
+
+SceneDesc parse_any(const std::string& bytes, const std::string& name, const LoadLimits& limits,
+                    const std::string& base_dir) {
   switch (detect_scene_format(bytes, name)) {
-    case SceneFormat::collada: return parse_collada(bytes, name, limits);
+    case SceneFormat::collada:
+      if (!looks_like_xml(bytes)) {
+        const std::string kind = what_it_is(bytes);
+        throw SceneError(name + ": not a COLLADA or glTF scene" + (kind.empty() ? "" : " (" + kind + ")"));
+      }
+      return parse_collada(bytes, name, limits);
     case SceneFormat::gltf: return parse_gltf(bytes, name, false, limits, base_dir);
     case SceneFormat::glb: return parse_gltf(bytes, name, true, limits, base_dir);
   }
   throw SceneError(name + ": unknown scene format");
+}
+
+}  // namespace
+
+SceneDesc parse_scene(const std::string& bytes, const std::string& name, const LoadLimits& limits,
+                      const std::string& base_dir) {
+  return parse_any(bytes, name, limits, base_dir);
 }
 
 SceneDesc load_scene(const std::string& path, const LoadLimits& limits) {

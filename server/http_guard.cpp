@@ -82,8 +82,20 @@ int http_status(JobErrorKind kind) {
   return 500;
 }
 
-void send_error_status(httplib::Response& res, int status, const std::string& message, const std::string& field) {
-  send_error(res, status, message, field);
+void send_error_status(httplib::Response& res, int status, const std::string& message, const std::string& field,
+                       const JobError::FieldErrors& errors) {
+  if (errors.size() > 1) {
+    json err{{"status", status}, {"message", message}, {"errors", json::array()}};
+    if (!field.empty()) err["field"] = field;
+    for (const auto& [f, m] : errors) {
+      json e{{"message", m}};
+      if (!f.empty()) e["field"] = f;
+      err["errors"].push_back(e);
+    }
+    send_json(res, status, json{{"error", err}});
+  } else {
+    send_error(res, status, message, field);
+  }
   if (status == 429 || status == 503) res.set_header("Retry-After", "5");
 }
 

@@ -63,7 +63,9 @@ class HttpError : public std::runtime_error {
 int http_status(JobErrorKind kind);
 
 // Answers an error with its JSON body (and Retry-After where retrying later helps).
-void send_error_status(httplib::Response& res, int status, const std::string& message, const std::string& field);
+// `errors`: every invalid field when a request has several (error.errors).
+void send_error_status(httplib::Response& res, int status, const std::string& message, const std::string& field,
+                       const JobError::FieldErrors& errors = {});
 
 // Runs a handler body, turning HttpError and JobError into their JSON errors and any other
 // exception into a 500 (503 when memory ran out): nothing thrown leaves a handler.
@@ -74,7 +76,7 @@ void guarded(httplib::Response& res, F&& f) {
   } catch (const HttpError& e) {
     send_error_status(res, e.status(), e.what(), e.field());
   } catch (const JobError& e) {
-    send_error_status(res, http_status(e.kind()), e.what(), e.field());
+    send_error_status(res, http_status(e.kind()), e.what(), e.field(), e.errors());
   } catch (const std::bad_alloc&) {
     send_error(res, 503, "the server is out of memory for this request; retry later");
   } catch (const std::exception& e) {

@@ -83,28 +83,42 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   Reader r{body, {}};
   JobSpec s;
   pt::RenderParams& p = s.params;
-  const json* scene = r.get("scene");
-  if (!scene) throw JobError(JobErrorKind::invalid, "'scene' is required", "scene");
-  if (!scene->is_string()) throw JobError(JobErrorKind::invalid, "'scene' must be a string", "scene");
-  s.scene = scene->get<std::string>();
-  if (!valid_scene_name(s.scene))
-    throw JobError(JobErrorKind::invalid, "'scene' must be a scene name (letters, digits, '_', '-', '.'; no paths)", "scene");
+  // Every field is checked, and every invalid one named at once (the first leads the answer).
+  JobError::FieldErrors errors;
+  auto check = [&](auto&& read) {
+    try {
+      read();
+    } catch (const JobError& e) {
+      errors.emplace_back(e.field(), e.what());
+    }
+  };
+  check([&] {
+    const json* scene = r.get("scene");
+    if (!scene) throw JobError(JobErrorKind::invalid, "'scene' is required", "scene");
+    if (!scene->is_string()) throw JobError(JobErrorKind::invalid, "'scene' must be a string", "scene");
+    s.scene = scene->get<std::string>();
+    if (!valid_scene_name(s.scene))
+      throw JobError(JobErrorKind::invalid, "'scene' must be a scene name (letters, digits, '_', '-', '.'; no paths)", "scene");
+  });
   pt::RunLimits run;
   for (const pt::RenderOption& o : pt::render_options()) {  // every field from the one table
-    auto [lo, hi] = job_range(o, lim);
-    double v = o.service;
-    switch (o.type) {
-      case pt::OptionType::integer: v = double(r.integer(o.name, (long long)o.service, (long long)lo, (long long)hi)); break;
-      case pt::OptionType::real:
-      case pt::OptionType::number: v = r.number(o.name, o.service, lo, hi); break;
-      case pt::OptionType::boolean: v = r.boolean(o.name, o.service != 0) ? 1 : 0; break;
-    }
-    o.set(p, run, v);
+    check([&] {
+      auto [lo, hi] = job_range(o, lim);
+      double v = o.service;
+      switch (o.type) {
+        case pt::OptionType::integer: v = double(r.integer(o.name, (long long)o.service, (long long)lo, (long long)hi)); break;
+        case pt::OptionType::real:
+        case pt::OptionType::number: v = r.number(o.name, o.service, lo, hi); break;
+        case pt::OptionType::boolean: v = r.boolean(o.name, o.service != 0) ? 1 : 0; break;
+      }
+      o.set(p, run, v);
+    });
   }
   s.time_limit = run.time_limit;
   s.target_error = run.target_error;
   for (auto it = body.begin(); it != body.end(); ++it)
-    if (!r.seen.count(it.key())) throw JobError(JobErrorKind::invalid, "unknown field '" + it.key() + "'", it.key());
+    if (!r.seen.count(it.key())) errors.emplace_back(it.key(), "unknown field '" + it.key() + "'");
+  if (!errors.empty()) throw JobError(JobErrorKind::invalid, std::move(errors));
   double pixel_samples = double(p.width) * p.height * p.spp;
   if (pixel_samples > lim.max_pixel_samples) {
     char buf[200];
@@ -114,8 +128,12 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   }
   try {
     p.validate();
-  } catch (const std::invalid_argument& e) {
-    throw JobError(JobErrorKind::invalid, e.what());
+  } catch (const std::invalid_argument& e) {  // "name (flag): why": the field is the option's name
+    const std::string what = e.what();
+    const std::string name = what.substr(0, what.find(' '));
+    bool known = false;
+    for (const pt::RenderOption& o : pt::render_options()) known = known || name == o.name;
+    throw JobError(JobErrorKind::invalid, what, known ? name : "");
   }
   return s;
 }

@@ -5,8 +5,9 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
-#include "render_scene.h"
 #include "render_scene.h"
 
 namespace srv {
@@ -36,12 +37,18 @@ class JobError : public std::runtime_error {
  public:
   JobError(JobErrorKind kind, std::string message, std::string field = "")
       : std::runtime_error(std::move(message)), m_kind(kind), m_field(std::move(field)) {}
+  // Every invalid field of a request at once (field, message); the first is what() and field().
+  using FieldErrors = std::vector<std::pair<std::string, std::string>>;
+  JobError(JobErrorKind kind, FieldErrors errors)
+      : std::runtime_error(errors.at(0).second), m_kind(kind), m_field(errors.at(0).first), m_errors(std::move(errors)) {}
   JobErrorKind kind() const { return m_kind; }
   const std::string& field() const { return m_field; }
+  const FieldErrors& errors() const { return m_errors; }  // empty for a single error
 
  private:
   JobErrorKind m_kind;
   std::string m_field;
+  FieldErrors m_errors;
 };
 
 struct JobSpec {

@@ -24,6 +24,7 @@
 #include "render_backend.h"
 #include "request_policy.h"
 #include "scene_file.h"
+#include "version.h"
 
 namespace srv {
 
@@ -140,17 +141,18 @@ void JobManager::stop() {
     if (w.joinable()) w.join();
 }
 
-JobSpec JobManager::check(const json& body, uint64_t* scene_hash) {
+JobSpec JobManager::check(const json& body, uint64_t* scene_hash, std::vector<std::string>* warnings) {
   JobSpec spec = parse_job_spec(body, m_config.limits);
   // A scene that does not load is refused here (422) rather than accepted as a job that fails.
-  const uint64_t hash = m_scenes.check(spec.scene);
+  const uint64_t hash = m_scenes.check(spec.scene, warnings);
   if (scene_hash) *scene_hash = hash;
   return spec;
 }
 
 std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const std::string& key) {
   uint64_t scene_hash = 0;
-  JobSpec spec = check(body, &scene_hash);
+  std::vector<std::string> warnings;
+  JobSpec spec = check(body, &scene_hash, &warnings);
   std::lock_guard<std::mutex> lock(m_mutex);
   if (m_stopping) throw JobError(JobErrorKind::shutting_down, "the server is shutting down");
   if (!key.empty()) {
@@ -168,6 +170,7 @@ std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const
   job->id = new_job_id();
   job->spec = spec;
   job->scene_hash = scene_hash;
+  job->warnings = std::move(warnings);
   job->idempotency_key = key;
   job->created_at = now_unix_seconds();
   {
@@ -226,6 +229,7 @@ json JobManager::status_json(const Job& j, bool with_history) const {
          {"tile_size", j.spec.params.tile_size},
          {"stream_tile_size", stream_tile_size(j.spec.params.tile_size)},
          {"features", j.features},
+         {"warnings", j.warnings},
          {"images", {{"png", "/api/jobs/" + j.id + "/image.png"}, {"exr", "/api/jobs/" + j.id + "/image.exr"}}},
          {"events", "/api/jobs/" + j.id + "/events"}};
   if (!j.message.empty()) s["message"] = j.message;
@@ -334,6 +338,8 @@ void JobManager::load_persisted() {
         if (doc.contains("finished_at") && doc["finished_at"].is_number()) job->finished_at = doc["finished_at"];
         for (const json& p : doc.value("error_history", json::array()))
           job->history.push_back({p.value("seconds", 0.0), p.value("spp", 0.0), p.value("error", 0.0)});
+        for (const json& w : doc.value("warnings", json::array()))
+          if (w.is_string()) job->warnings.push_back(to_valid_utf8(w.get<std::string>()));
         if (doc.contains("features"))
           for (const json& f : doc["features"])
             if (f.is_string()) job->features.push_back(to_valid_utf8(f.get<std::string>()));
@@ -453,7 +459,8 @@ void JobManager::store_images(Job& job, const RenderResult& result) {
   const pt::ImageRGB& img = result.image;
   if (img.pixels.empty()) return;
   const RenderReport& r = result.report;
-  pt::Metadata meta{{"pathtracer:scene", job.spec.scene},
+  pt::Metadata meta{{"pathtracer:version", pt::version_text("render-server")},
+                    {"pathtracer:scene", job.spec.scene},
                     {"pathtracer:job", job.id},
                     {"pathtracer:spec", dump_json(job_spec_to_json(job.spec))},
                     {"pathtracer:achieved_spp", std::to_string(double(r.samples) / (double(img.width) * img.height))},

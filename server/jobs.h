@@ -61,6 +61,7 @@ struct Job {
   uint64_t checkpoint_samples = 0;  // what the job's checkpoint holds (a restart shows these)
   double checkpoint_seconds = 0;
   std::vector<std::string> features;
+  std::vector<std::string> warnings;  // what the scene's loader ignored or defaulted (its summary's)
 
   // The live image: linear RGB and its 8-bit display version. Clients are sent it in regions of at
   // least kMinRegion pixels a side whatever the render's tile size (tiles nest in regions), so
@@ -110,7 +111,7 @@ class JobManager {
   // Validates and queues; returns the job and whether it was created (false: same idempotency key).
   std::pair<std::shared_ptr<Job>, bool> submit(const json& body, const std::string& idempotency_key);
   // Validates only (scene existence included); returns the normalised spec.
-  JobSpec check(const json& body, uint64_t* scene_hash = nullptr);
+  JobSpec check(const json& body, uint64_t* scene_hash = nullptr, std::vector<std::string>* warnings = nullptr);
   std::shared_ptr<Job> get(const std::string& id) const;
   std::vector<std::shared_ptr<Job>> list() const;
   JobPage page(size_t limit, const std::string& cursor, const std::string& state) const;

@@ -14,6 +14,7 @@
 #include "image.h"
 #include "jobs.h"
 #include "routes.h"
+#include "version.h"
 
 extern const char* kOpenApiJson;  // generated from server/openapi.json at build time
 
@@ -52,7 +53,8 @@ const char* kUsage =
     "  --max-connections N  open connections before new ones are answered 503 (default 128; kept\n"
     "                    below the process's file-descriptor limit)\n"
     "  --read-timeout SEC   seconds to receive a whole request, however slowly sent (default 10)\n"
-    "  -h, --help        this text\n";
+    "  -h, --help        this text\n"
+    "  --version         the version, git commit, Embree and OpenImageIO versions\n";
 
 bool parse_seconds(const char* s, double* out) {
   char* end;
@@ -130,13 +132,13 @@ int main(int argc, char** argv) {
     std::string a = argv[i];
     auto value = [&]() -> const char* {
       if (i + 1 >= argc) {
-        std::fprintf(stderr, "render-server: %s needs a value\n\n%s", a.c_str(), kUsage);
+        std::fprintf(stderr, "render-server: %s needs a value (see --help)\n", a.c_str());
         std::exit(2);
       }
       return argv[++i];
     };
     auto bad = [&](const char* v) {
-      std::fprintf(stderr, "render-server: bad value '%s' for %s\n\n%s", v, a.c_str(), kUsage);
+      std::fprintf(stderr, "render-server: bad value '%s' for %s (see --help)\n", v, a.c_str());
       std::exit(2);
     };
     if (a == "--host") host = value();
@@ -165,7 +167,8 @@ int main(int argc, char** argv) {
     else if (a == "--max-connections") { const char* v = value(); if (!parse_int(v, 1, 10000, &n)) bad(v); api.limits.max_connections = int(n); }
     else if (a == "--read-timeout") { const char* v = value(); if (!parse_seconds(v, &api.limits.request_timeout)) bad(v); }
     else if (a == "-h" || a == "--help") { std::printf("%s", kUsage); return 0; }
-    else { std::fprintf(stderr, "render-server: unknown option '%s'\n\n%s", a.c_str(), kUsage); return 2; }
+    else if (a == "--version") { std::printf("%s\n", pt::version_text("render-server").c_str()); return 0; }
+    else { std::fprintf(stderr, "render-server: unknown option '%s' (see --help)\n", a.c_str()); return 2; }
   }
   if (!scenes_given) cfg.scene_dirs = {PT_SOURCE_DIR "/scenes", PT_BINARY_DIR "/scenes"};
 

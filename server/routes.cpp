@@ -13,6 +13,7 @@
 #include "image.h"
 #include "job_store.h"
 #include "scene_file.h"
+#include "version.h"
 
 namespace srv {
 
@@ -40,6 +41,8 @@ void get_health(JobManager& jobs, const ApiOptions&, const Request&, Response& r
   }
   json health{{"status", "ok"}, {"queued", queued}, {"running", running}, {"paused", paused}, {"rendering", jobs.backend_name()},
               {"data_bytes", jobs.data_bytes()}};
+  const pt::VersionInfo& v = pt::version_info();
+  health["version"] = {{"version", v.version}, {"commit", v.commit}, {"embree", v.embree}, {"openimageio", v.openimageio}};
   StreamStats st = stream_stats();
   health["stream"] = {{"watchers", st.watchers}, {"png_encodes", st.png_encodes}, {"tile_events", st.tile_events}};
   int workers = jobs.live_workers();

@@ -38,7 +38,8 @@ json summarize_desc(const pt::SceneDesc& d) {
               {"lights", std::vector<std::string>(lights.begin(), lights.end())},
               {"materials", std::vector<std::string>(mats.begin(), mats.end())},
               {"has_camera", d.camera.present},
-              {"center_distance", focus}};
+              {"center_distance", focus},
+              {"warnings", d.warnings}};
 }
 
 SceneLibrary::SceneLibrary(std::vector<std::string> dirs, size_t cache_bytes) : m_cache_bytes(cache_bytes) {
@@ -245,10 +246,12 @@ SceneLibrary::FileSummary SceneLibrary::file_summary(const std::string& name) {
   return cached;
 }
 
-uint64_t SceneLibrary::check(const std::string& name) {
+uint64_t SceneLibrary::check(const std::string& name, std::vector<std::string>* warnings) {
   if (resolve(name).empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "scene");
   const FileSummary file = file_summary(name);
   if (!file.error.empty()) throw JobError(JobErrorKind::scene_broken, "scene '" + name + "' does not load: " + file.error, "scene");
+  if (warnings && file.summary.contains("warnings"))
+    for (const json& w : file.summary["warnings"]) warnings->push_back(w.get<std::string>());
   return file.hash;
 }
 

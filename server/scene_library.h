@@ -58,7 +58,8 @@ class SceneLibrary {
   // Throws JobError(not_found) for an unknown name, JobError(scene_broken) naming the loader's
   // message for a file that does not load (parsed once per file version). Returns the hash of the
   // file's content, which a job keeps to know its scene is the one its film was rendered from.
-  uint64_t check(const std::string& name);
+  // `warnings`, when given, receives what the loader ignored or defaulted.
+  uint64_t check(const std::string& name, std::vector<std::string>* warnings = nullptr);
 
  private:
   using Base = std::shared_ptr<const pt::SceneBase>;

@@ -22,6 +22,7 @@
 #include "session.h"
 #include "job_spec.h"
 #include "redis_queue.h"
+#include "version.h"
 
 namespace {
 
@@ -36,7 +37,8 @@ const char* kUsage =
     "  --claim-timeout SEC  take over passes a worker left unacknowledged this long (default 10)\n"
     "  --redis-timeout SEC  wait this long for an unreachable Redis, then exit (default 300)\n"
     "  --quiet              log nothing but errors\n"
-    "  -h, --help           this text\n";
+    "  -h, --help           this text\n"
+    "  --version            the version, git commit, Embree and OpenImageIO versions\n";
 
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
@@ -347,6 +349,9 @@ bool parse_options(int argc, char** argv, Options& o) {
     };
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
+      return false;
+    } else if (a == "--version") {
+      std::printf("%s\n", pt::version_text("render-worker").c_str());
       return false;
     } else if (a == "--queue") {
       o.queue = value();

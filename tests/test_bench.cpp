@@ -17,14 +17,9 @@ namespace {
 
 // Runs a command, returns its exit status; its stdout and stderr go to `out`.
 int run(const std::string& cmd, std::string& out) {
-  out.clear();
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return -1;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  int status = pclose(p);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  pt::test::RunResult r = pt::test::run_command(cmd);
+  out = r.output;
+  return r.status;
 }
 
 // The benchmark's first line names the machine: its CPU model, the CPUs it may use and the widest

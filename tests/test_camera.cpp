@@ -7,6 +7,7 @@
 
 #include "collada.h"
 #include "lane_math.h"
+#include "render_scene.h"
 #include "rng.h"
 #include "simd.h"
 #include "test_util.h"
@@ -303,4 +304,67 @@ TEST(Camera, ThinLensRaysInLanesAreGenerateRaysBits) {
       }
     }
   }
+}
+
+// --frame-scene keeps the course's view direction and fits the field of view to the projected
+// bounds: all of the box is in the image, and a 5% narrower view would cut some of it off.
+TEST(Camera, FrameSceneFitsTheProjectedBoundsToTheImage) {
+  SceneDesc s = box_scene();
+  CameraParams p;
+  p.width = 480;
+  p.height = 360;
+  const Camera course = make_camera(s, p);
+  p.frame_scene = true;
+  const Camera fitted = make_camera(s, p);
+  EXPECT_EQ(length(fitted.position - course.position), 0.0f);
+  EXPECT_EQ(length(fitted.back - course.back), 0.0f);
+  const Bounds3 b = s.geometry_bounds();
+  EXPECT_FLOAT_EQ(visible_bounds_fraction(fitted, b), 1.0f);
+  Camera tighter = fitted;
+  tighter.tan_half_w *= 0.95f, tighter.tan_half_h *= 0.95f;
+  EXPECT_LT(visible_bounds_fraction(tighter, b), 0.99f);
+  // The course's crop at a small size shows only part of it.
+  p.frame_scene = false;
+  p.width = 160;
+  p.height = 120;
+  EXPECT_LT(visible_bounds_fraction(make_camera(s, p), b), 0.9f);
+  // Pixels stay square.
+  EXPECT_NEAR(fitted.tan_half_w / fitted.tan_half_h, 480.0 / 360.0, 1e-5);
+}
+
+// Autofocus sets the depth along the view axis of what the click hits (the thin lens focuses on a
+// plane at that depth), checked against geometry whose depth we know, off the centre of the view.
+TEST(Camera, AutofocusOffCentreIsTheHitsDepthAlongTheViewAxis) {
+  SceneDesc s;
+  MeshDesc wall;  // a wall at z = 0 facing +z, far wider than the view
+  wall.positions = {{-50, -50, 0}, {50, -50, 0}, {50, 50, 0}, {-50, 50, 0}};
+  wall.indices = {0, 1, 2, 0, 2, 3};
+  wall.tri_material = {0, 0};
+  s.meshes.push_back(wall);
+  SphereDesc ball;  // a sphere of radius 0.5 in front of the wall, up and to the right
+  ball.center = Vec3(3, 2, 4);
+  ball.radius = 0.5f;
+  ball.material = 0;
+  s.spheres.push_back(ball);
+  s.materials.push_back(Material());
+  LightDesc light;
+  light.type = LightType::point;
+  light.position = Vec3(0, 0, 20);
+  light.color = Vec3(1.0f);
+  s.lights.push_back(light);
+  RenderParams params;
+  auto scene = make_render_scene(s, params);
+  Camera& c = scene->camera;  // looking down -z from z = 10
+  c.position = Vec3(0, 0, 10), c.right = Vec3(1, 0, 0), c.up = Vec3(0, 1, 0), c.back = Vec3(0, 0, 1);
+  c.tan_half_w = 0.8f, c.tan_half_h = 0.6f;
+  // The wall: depth 10 wherever it is clicked, the corners too (the ray's length there is 12.8).
+  for (float sx : {0.5f, 0.1f, 0.9f})
+    for (float sy : {0.5f, 0.1f, 0.95f}) EXPECT_NEAR(autofocus_distance(*scene, sx, sy), 10.0f, 1e-4f) << sx << " " << sy;
+  // The sphere, clicked at its centre's image: the ray meets it |C - O| - r along, at depth
+  // (|C - O| - r) cos(angle) with cos = 6 / |C - O|.
+  const Vec3 to = ball.center - c.position;  // (3, 2, -6)
+  const float sx = 0.5f + 0.5f * (to.x / 6) / c.tan_half_w, sy = 0.5f + 0.5f * (to.y / 6) / c.tan_half_h;
+  const float expect = (length(to) - 0.5f) * 6 / length(to);
+  EXPECT_NEAR(autofocus_distance(*scene, sx, sy), expect, 1e-4f);
+  EXPECT_GT(length(to) - 0.5f - expect, 0.7f);  // the distance along the ray would be this far off
 }

@@ -16,21 +16,9 @@
 namespace pt {
 namespace {
 
-struct RunResult {
-  int status;
-  std::string output;
-};
+using test::RunResult;
 
-RunResult run(const std::string& args) {
-  std::string cmd = std::string(PT_PATHTRACER) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
+RunResult run(const std::string& args) { return test::run_command(std::string(PT_PATHTRACER) + " " + args); }
 
 
 // The pixels of an EXR, for bit-for-bit comparisons (the headers differ: times, checkpoint notes).

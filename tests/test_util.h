@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 #include <filesystem>
 
+#include <sys/wait.h>
+
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <sstream>
 #include <string>
@@ -53,6 +56,22 @@ inline std::string diffuse_sphere_scene(float rho, float camera_z, float fov, co
 struct AllowAvx2Afterwards {
   ~AllowAvx2Afterwards() { simd::allow_avx2(true); }
 };
+
+// A command's exit status (-1 when it did not exit) and its stdout and stderr together.
+struct RunResult {
+  int status;
+  std::string output;
+};
+inline RunResult run_command(const std::string& cmd) {
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return {-1, ""};
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
 
 inline bool file_exists(const std::string& p) {
   struct stat st;

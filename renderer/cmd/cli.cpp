@@ -3,12 +3,15 @@
 #include "cli.h"
 
 #include "options.h"
+#include "version.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <thread>
 
 namespace pt {
 
@@ -45,21 +48,62 @@ double parse_option(const std::string& flag, const char* name, const std::string
   return parse_float(flag, s, o.min, o.max);
 }
 
+// Edit distance (insertions, deletions, substitutions, adjacent swaps) between two short strings.
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (size_t i = 1; i <= a.size(); ++i)
+    for (size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1])});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
 }  // namespace
+
+std::vector<std::string> cli_option_names() {
+  // The options --help lists: each help line that starts with "  -" names one (or two: "-h, --help").
+  std::vector<std::string> names;
+  std::istringstream help(usage_text("pathtracer"));
+  for (std::string line; std::getline(help, line);) {
+    if (line.compare(0, 3, "  -") != 0) continue;
+    std::istringstream words(line);
+    for (std::string w; words >> w && w[0] == '-';) {
+      if (w.back() == ',') w.pop_back();
+      names.push_back(w);
+    }
+  }
+  return names;
+}
+
+std::string nearest_option(const std::string& given) {
+  if (given.size() > 64) return "";
+  std::string best;
+  size_t best_d = ~size_t(0);
+  for (const std::string& name : cli_option_names()) {
+    const size_t d = edit_distance(given, name);
+    if (d < best_d) best_d = d, best = name;
+  }
+  // Close enough to be a slip: a third of the name at most (--target-eror, --keepfov, -nosamples no).
+  return best_d <= std::max<size_t>(1, best.size() / 3) ? best : "";
+}
 
 CliOptions parse_cli(const std::vector<std::string>& args) {
   CliOptions o;
   RenderParams& p = o.params;
   size_t i = 0;
+  bool threads_given = false, spp_given = false;
   auto need = [&](const std::string& flag, size_t count) {
     if (i + count >= args.size())
       throw UsageError(flag + " needs " + std::to_string(count) + " value" + (count > 1 ? "s" : ""));
   };
   for (i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "-s") { need(a, 1); p.spp = int(parse_option(a, "spp", args[++i])); }
+    if (a == "-s") { need(a, 1); p.spp = int(parse_option(a, "spp", args[++i])); spp_given = true; }
     else if (a == "-l") { need(a, 1); p.light_samples = int(parse_option(a, "light_samples", args[++i])); }
-    else if (a == "-t") { need(a, 1); p.threads = int(parse_int(a, args[++i], 1, 1024)); }
+    else if (a == "-t") { need(a, 1); p.threads = int(parse_int(a, args[++i], 1, 1024)); threads_given = true; }
     else if (a == "-m") { need(a, 1); p.max_depth = int(parse_option(a, "max_depth", args[++i])); }
     else if (a == "-e") { need(a, 1); p.env_map = args[++i]; }
     else if (a == "-b") { need(a, 1); p.lens_radius = float(parse_option(a, "aperture", args[++i])); }
@@ -85,6 +129,8 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "-h" || a == "--help") { o.help = true; }
     else if (a == "--no-adaptive") { p.adaptive = false; }
     else if (a == "--keep-fov") { p.keep_fov = true; }
+    else if (a == "--frame-scene") { p.frame_scene = true; }
+    else if (a == "--version") { o.version = true; }
     else if (a == "--no-caustic-tracing") { p.caustic_tracing = false; }
     else if (a == "--no-default-light") { p.default_light = false; }
     else if (a == "--sampler") {
@@ -110,14 +156,22 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
       if (o.checkpoint.empty()) throw UsageError("--checkpoint: empty file name");
     } else if (a == "--checkpoint-interval") { need(a, 1); o.checkpoint_interval = parse_float(a, args[++i], 0, 1e9); }
     else if (a == "--script") { need(a, 1); o.script = args[++i]; }
-    else if (a.size() > 1 && a[0] == '-') { throw UsageError("unknown option '" + a + "'"); }
+    else if (a.size() > 1 && a[0] == '-') {
+      const std::string near = nearest_option(a);
+      throw UsageError("unknown option '" + a + "'" + (near.empty() ? "" : " (did you mean " + near + "?)"));
+    }
     else {
       if (!o.scene_path.empty()) throw UsageError("more than one scene file given ('" + o.scene_path + "', '" + a + "')");
       o.scene_path = a;
     }
   }
-  if (o.help) return o;
+  if (o.help || o.version) return o;
   if (o.scene_path.empty()) throw UsageError("no scene file given");
+  // The course renders on one thread unless told; every core gives the same image sooner.
+  if (!threads_given) p.threads = std::max(1, std::min(1024, int(std::thread::hardware_concurrency())));
+  // An error target without a sample budget means "until the target" (or the time limit).
+  if (!spp_given && o.limits.target_error > 0) p.spp = int(render_option("spp").max);
+  o.spp_given = spp_given;
   if (!o.checkpoint.empty() && o.output.empty()) throw UsageError("--checkpoint needs -f (the window keeps no checkpoint)");
   try {
     p.validate();
@@ -134,7 +188,7 @@ std::string usage_text(const std::string& program) {
 "Course flags (same meaning as the CS184 pathtracer):\n"
 "  -s <INT>        camera rays (samples) per pixel (default 1; 1 = one ray through the pixel centre)\n"
 "  -l <INT>        samples per area / environment / ambient light (default 1)\n"
-"  -t <INT>        render threads (default 1; more than the cores is fine)\n"
+"  -t <INT>        render threads (default: every core; the course's is 1; the image is the same)\n"
 "  -m <INT>        maximum ray depth (default 1): 0 = emitters only, 1 = direct light,\n"
 "                  each further bounce (specular events included) needs one more level\n"
 "  -e <PATH>       OpenEXR lat-long environment map, importance-sampled\n"
@@ -150,6 +204,7 @@ std::string usage_text(const std::string& program) {
 "  -p <x> <y> <dx> <dy> render only this cell (bottom-left origin) and write a dx x dy image\n"
 "  -H              uniform hemisphere sampling for direct lighting instead of light sampling\n"
 "  -h, --help      this text\n"
+"  --version       the version, git commit, Embree and OpenImageIO versions\n"
 "\n"
 "Our options:\n"
 "  --no-adaptive   take exactly -s samples in every pixel\n"
@@ -159,6 +214,7 @@ std::string usage_text(const std::string& program) {
 "  --tile <INT>    tile size in pixels (default 32)\n"
 "  --quiet         no progress bar\n"
 "  --keep-fov      -r scales the course's 800x600 view to the output size instead of cropping it\n"
+"  --frame-scene   the course's view direction, zoomed so the scene's bounds fill the image\n"
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
 "  --no-default-light    no white environment for a glTF scene without lights or emitters\n"
@@ -170,7 +226,8 @@ std::string usage_text(const std::string& program) {
 "                         between: seconds, progress, ETA (-1: unknown), the sample budget's\n"
 "                         fraction, 1 at a pass's end, the samples taken and predicted still to take\n"
 "                         at the last pass's end\n"
-"  --target-error <X>     stop once the estimated relative MSE is <= X\n"
+"  --target-error <X>     stop once the estimated relative MSE is <= X (without -s: however many\n"
+"                         samples that takes, bounded by --time-limit when given)\n"
 "  --time-limit <SEC>     stop after SEC seconds of rendering\n"
 "  --reference <FILE>     a converged image of the same size: log its true RMSE and relative MSE\n"
 "  --checkpoint <FILE>    save the render to FILE between passes; the same command run again\n"
@@ -209,7 +266,7 @@ Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
     return s.str();
   };
   double pixels = double(session.width()) * session.height();
-  Metadata meta{{"pathtracer:scene", o.scene_path}};
+  Metadata meta{{"pathtracer:version", version_text("pathtracer")}, {"pathtracer:scene", o.scene_path}};
   for (const RenderOption& opt : render_options())  // every render option, from the one table
     meta.push_back({opt.metadata, option_text(opt, opt.get(p, o.limits))});
   Metadata run{{"pathtracer:achieved_spp", num(pixels > 0 ? st.samples / pixels : 0)},

@@ -14,6 +14,8 @@ struct CliOptions {
   std::string scene_path;
   std::string output;      // -f; empty opens the debug window
   bool help = false;
+  bool version = false;    // --version
+  bool spp_given = false;  // -s was on the command line (hints and the error target read it)
   bool quiet = false;      // --quiet: no progress bar
   std::string script;      // --script: window input replayed from a file (tests)
   bool describe = false;   // --describe: print the feature set and memory, no render
@@ -33,6 +35,9 @@ class UsageError : public std::runtime_error {
 // Parses argv; throws UsageError naming the flag on anything malformed.
 CliOptions parse_cli(const std::vector<std::string>& args);
 std::string usage_text(const std::string& program);
+// The options --help lists ("-s", "--keep-fov", ...), and the one nearest a mistyped one ("" if none is near).
+std::vector<std::string> cli_option_names();
+std::string nearest_option(const std::string& given);
 // The debug window's keys, one a line (part of usage_text; the window's H key prints it).
 std::string window_keys_text();
 // The EXR header of a render: its parameters, achieved samples, wall time and error estimate.

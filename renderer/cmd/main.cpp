@@ -15,8 +15,10 @@
 #include "cli.h"
 #include "scene_file.h"
 #include "diffuse_lanes.h"
+#include "hints.h"
 #include "progress.h"
 #include "session.h"
+#include "version.h"
 #include "viewer.h"
 
 using namespace pt;
@@ -80,12 +82,16 @@ int main(int argc, char** argv) {
   CliOptions o;
   try {
     o = parse_cli(args);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "pathtracer: %s\n\n%s", e.what(), usage_text(argv[0]).c_str());
+  } catch (const UsageError& e) {  // one line, not the whole help
+    std::fprintf(stderr, "pathtracer: %s (see --help)\n", e.what());
     return 1;
   }
   if (o.help) {
     std::printf("%s", usage_text(argv[0]).c_str());
+    return 0;
+  }
+  if (o.version) {
+    std::printf("%s\n", version_text("pathtracer").c_str());
     return 0;
   }
   if (o.output.empty() && !o.describe) return run_viewer(o);
@@ -101,6 +107,12 @@ int main(int argc, char** argv) {
     auto scene = make_render_scene(desc, o.params);
     double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.describe) return describe_scene(o, desc, *scene, load_s);
+    if (!o.quiet) {
+      const bool course_framing = o.params.camera_file.empty() && !o.params.file_camera &&
+                                  !(desc.camera.as_authored && desc.camera.present);
+      for (const std::string& h : render_hints(o, scene->features, scene->camera, desc.geometry_bounds(), course_framing))
+        std::fprintf(stderr, "hint: %s\n", h.c_str());
+    }
     desc = SceneDesc();  // the render scene holds what rendering reads: drop the file's copy
     if (!o.quiet)
       std::fprintf(stderr, "Loaded %s: %zu triangles, %zu spheres, %zu lights in %.3f s\n", o.scene_path.c_str(),

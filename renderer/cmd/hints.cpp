@@ -1,0 +1,39 @@
+// Hints for disappointing settings (hints.h).
+#include "hints.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "camera.h"
+#include "render_scene.h"
+
+namespace pt {
+
+std::vector<std::string> render_hints(const CliOptions& o, const SceneFeatures& f, const Camera& camera,
+                                      const Bounds3& bounds, bool course_framing) {
+  std::vector<std::string> hints;
+  const RenderParams& p = o.params;
+  auto has = [&](const char* m) { return std::find(f.materials.begin(), f.materials.end(), m) != f.materials.end(); };
+  // Depth 1 is direct light only and depth 2 one bounce: a mirror shows the lit room from 2, glass
+  // (in, out, then the room) from 3 (cs184-spec: each specular event takes one level).
+  if (p.max_depth < 3 && (has("mirror") || has("glass") || has("refraction")))
+    hints.push_back("-m " + std::to_string(p.max_depth) + " leaves mirror and glass " +
+                    (p.max_depth < 2 ? "black" : "dark") + ": what they reflect and refract needs -m 3 or more "
+                    "(-m 5 for glass seen through glass)");
+  if (p.spp == 1 && !(o.limits.target_error > 0))
+    hints.push_back("-s 1 takes one sample a pixel, through its centre: expect jagged edges and heavy noise "
+                    "(-s 64 or more, or --target-error 0.01)");
+  if (course_framing && !p.keep_fov && !p.frame_scene) {
+    const float shown = visible_bounds_fraction(camera, bounds);
+    if (shown < 0.5f) {
+      char pct[16];
+      std::snprintf(pct, sizeof pct, "%.0f%%", 100 * shown);
+      hints.push_back("-r " + std::to_string(p.width) + " " + std::to_string(p.height) + " shows " + pct +
+                      " of the scene: as in the course, a size below 800x600 crops the centre of its view; "
+                      "--keep-fov scales the whole view, --frame-scene fits the scene to the image");
+    }
+  }
+  return hints;
+}
+
+}  // namespace pt

@@ -1,0 +1,20 @@
+// One-line hints for settings that will visibly disappoint (the course's defaults among them): the
+// pathtracer command prints them before it renders, so a black mirror or a crop says why.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cli.h"
+
+namespace pt {
+
+struct Camera;
+struct SceneFeatures;
+
+// `course_framing`: the camera is the course's (no -c, no --file-camera, no glTF camera);
+// `bounds`: the geometry bounds the course frames. Each hint names the flag that helps.
+std::vector<std::string> render_hints(const CliOptions& options, const SceneFeatures& features, const Camera& camera,
+                                      const Bounds3& bounds, bool course_framing);
+
+}  // namespace pt

@@ -1,0 +1,48 @@
+"""What the service says to a new user: every invalid field of a job at once, what the scene's
+loader ignored or defaulted (in the scene list and in the job's status), and what it is (its
+version in /api/health and --version on both binaries)."""
+import re
+import subprocess
+
+from support import CORNELL, RENDER_SERVER, TINY
+from test_scale_out import RENDER_WORKER
+
+
+def test_every_invalid_field_is_named_at_once(server):
+    api = server.api
+    # The first in the options table's order leads: max_depth, then spp, then unknown fields.
+    err = api.error(api.post("/api/jobs", dict(TINY, spp=0, max_depth=-1, bogus=1)), 400, "max_depth")
+    assert [e["field"] for e in err["errors"]] == ["max_depth", "spp", "bogus"], err
+    assert err["errors"][0] == {"field": "max_depth", "message": err["message"]}
+    assert all(e["message"] for e in err["errors"])
+    # One invalid field: the answer is as it always was, without a list.
+    assert "errors" not in api.error(api.post("/api/jobs", dict(TINY, spp=0)), 400, "spp")
+    # /check names them the same way, and two framings at once are refused naming the new one.
+    assert len(api.error(api.post("/api/jobs/check", dict(TINY, width=0, height=0)), 400, "width")["errors"]) == 2
+    api.error(api.post("/api/jobs", dict(TINY, keep_fov=True, frame_scene=True)), 400, "frame_scene")
+
+
+def test_what_the_loader_ignored_reaches_the_scene_list_and_the_jobs_status(server):
+    api = server.api
+    no_camera = re.sub(rb'<instance_camera url="[^"]*"/>', b"", CORNELL.read_bytes())
+    summary = api.request("PUT", "/api/scenes/nocam", 201, data=no_camera,
+                          headers={"Content-Type": "model/vnd.collada+xml"}).json()["summary"]
+    assert any("no <instance_camera>" in w and w.startswith("nocam.dae:") for w in summary["warnings"]), summary
+    assert api.get("/api/scenes").json()["scenes"] and not next(
+        s for s in api.get("/api/scenes").json()["scenes"] if s["name"] == "cornell")["summary"]["warnings"]
+    job = api.submit(dict(TINY, scene="nocam"))
+    assert job["warnings"] == summary["warnings"]
+    done = api.wait(job["id"], ("done", "failed"), timeout=30)
+    assert done["state"] == "done" and done["warnings"] == summary["warnings"]
+    assert api.submit(dict(TINY))["warnings"] == []
+
+
+def test_health_and_the_binaries_say_their_version(server):
+    version = server.api.get("/api/health").json()["version"]
+    assert re.fullmatch(r"\d+\.\d+\.\d+", version["version"]) and version["commit"]
+    assert version["embree"].startswith("3.") and version["openimageio"].startswith("2."), version
+    for binary, name in ((RENDER_SERVER, "render-server"), (RENDER_WORKER, "render-worker")):
+        out = subprocess.run([str(binary), "--version"], capture_output=True, text=True, timeout=30)
+        assert out.returncode == 0
+        assert out.stdout == (f"{name} {version['version']} (commit {version['commit']}), "
+                              f"Embree {version['embree']}, OpenImageIO {version['openimageio']}\n")
