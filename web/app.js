@@ -9,8 +9,26 @@
 const FIELDS = {
   scene: 'select', max_depth: 'int', light_samples: 'int', aperture: 'num', focal_distance: 'num',
   spp: 'int', width: 'int', height: 'int', seed: 'int', time_limit: 'num', target_error: 'num', adaptive: 'bool',
-  adaptive_tolerance: 'num', keep_fov: 'bool', caustic_tracing: 'bool',
+  adaptive_tolerance: 'num', caustic_tracing: 'bool',
 };
+
+// The framing select sets two job fields (the API refuses both true): value -> fields, and what it does.
+const FRAMINGS = {
+  scene: { frame_scene: true, keep_fov: false, hint: 'The course\'s view direction, zoomed so the scene fills the image.' },
+  crop: { frame_scene: false, keep_fov: false, hint: 'As the course renders: a pixel keeps its angle, and a smaller image shows the centre of the view.' },
+  whole: { frame_scene: false, keep_fov: true, hint: 'The course\'s whole view, scaled to this size.' },
+};
+const FRAMING_FIELDS = ['frame_scene', 'keep_fov'];  // their errors show beside the select
+
+function framingOf(spec) {
+  if (spec.frame_scene) return 'scene';
+  return spec.keep_fov ? 'whole' : 'crop';
+}
+
+function showFramingHint() {
+  const f = FRAMINGS[$('#f-framing').value];
+  $('#framing-hint').textContent = f ? `${f.hint} COLLADA scenes; a glTF scene keeps its own camera.` : '';
+}
 
 // ---------- the main viewer ----------
 
@@ -259,6 +277,8 @@ function readSpec() {
     else if (el.validity && el.validity.badInput) errors[name] = 'Enter a number.';
     else if (el.value.trim() !== '') spec[name] = Number(el.value);
   }
+  const framing = FRAMINGS[$('#f-framing').value];
+  for (const name of FRAMING_FIELDS) spec[name] = framing[name];
   return { spec, errors };
 }
 
@@ -268,6 +288,7 @@ function clearErrors() {
 }
 
 function showError(field, message) {
+  if (FRAMING_FIELDS.includes(field)) field = 'framing';
   const line = field && document.getElementById(`err-${field}`);
   if (line) {
     line.textContent = message;
@@ -370,6 +391,8 @@ function fillForm(spec) {
     if (kind === 'bool') el.checked = !!spec[name];
     else el.value = spec[name] === null ? '' : String(spec[name]);
   }
+  $('#f-framing').value = framingOf(spec);
+  showFramingHint();
   showSceneSummary();
   scheduleCheck();
 }
@@ -399,8 +422,9 @@ async function loadScenes() {
       else el.value = String(state.defaults[name]);
       if (kind !== 'bool') el.placeholder = String(state.defaults[name]);
     }
-    // The API keeps the course's cropping by default; on the page a small image shows the whole view.
-    input('keep_fov').checked = true;
+    // The API keeps the course's cropping by default; on the page the scene fills the image.
+    $('#f-framing').value = 'scene';
+    showFramingHint();
   }
   showSceneSummary();
   return true;
@@ -417,6 +441,7 @@ function init() {
   });
   form.addEventListener('change', (e) => {
     if (e.target.id === 'f-scene') showSceneSummary();
+    if (e.target.id === 'f-framing') showFramingHint();
     scheduleCheck();
   });
   $('#use-center').addEventListener('click', (e) => {

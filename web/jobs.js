@@ -13,6 +13,8 @@ const OTHER_SETTINGS = [
   ['time_limit', (v) => `limit ${v} s`],
   ['seed', (v) => `seed ${v}`],
   ['caustic_tracing', (v) => (v ? 'caustics' : 'no caustics')],
+  ['frame_scene', (v) => (v ? 'fitted to the scene' : 'course framing')],
+  ['keep_fov', (v) => (v ? 'whole course view' : 'course crop')],
 ];
 
 // The columns after Job and Created: [class, text of a job, key compared between neighbours or null].

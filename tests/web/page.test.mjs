@@ -114,7 +114,10 @@ test('every invalid field an error answer lists is marked at once', async () => 
     assert.equal(await page.$$eval('#job-form [aria-invalid="true"]', (els) => els.length), listed.length);
     await page.unroute('**/api/jobs/check');
   }
-  await page.evaluate(() => checkForm());
+  // The server's own answer names both fields at once.
+  await fill({ spp: 0, width: 100000 });
+  await page.waitForFunction(() => ['spp', 'width'].every((f) => document.querySelector(`#f-${f}`).getAttribute('aria-invalid') === 'true'));
+  await fill({ spp: 8, width: 96 });
   await page.waitForFunction(() => !document.querySelector('#job-form [aria-invalid]'));
 });
 

@@ -73,9 +73,35 @@ async function showJob(values) {
 
 let jobA, jobB;
 
-test('exposure doubles linear values per stop; the course curve at 0 is the PNG', async () => {
+// The share of a canvas's pixels that are near black (every channel at most 8 of 255).
+async function blackShare(selector) {
+  const { rgba } = await canvasPixels(selector);
+  let black = 0;
+  for (let i = 0; i < rgba.length; i += 4) black += rgba[i] <= 8 && rgba[i + 1] <= 8 && rgba[i + 2] <= 8;
+  return black / (rgba.length / 4);
+}
+
+test('the scene-fitted framing (the default) fills the image; the course crop and whole view leave black', async () => {
+  assert.equal(await page.inputValue('#f-framing'), 'scene');
+  const share = {};
+  for (const framing of ['scene', 'crop', 'whole']) {
+    await page.selectOption('#f-framing', framing);
+    // 640x480: the course crop is the middle 80% of the course's 800x600 view (smaller sizes crop
+    // into the box, and show less of it rather than black).
+    const id = await submit({ scene: 'cornell', width: 640, height: 480, spp: 4, max_depth: 3 });
+    await waitViewerEnded('done');
+    const spec = (await api.json(`/api/jobs/${id}`)).spec;
+    assert.deepEqual([spec.frame_scene, spec.keep_fov], { scene: [true, false], crop: [false, false], whole: [false, true] }[framing]);
+    share[framing] = await blackShare('#v-canvas');
+    await page.locator('#v-wrap').screenshot({ path: path.join(artifacts, `web-viewer-framing-${framing}.png`) });
+  }
+  assert.ok(share.scene < share.crop / 2 && share.scene < share.whole / 2, `near-black shares: ${JSON.stringify(share)}`);
+  await page.selectOption('#f-framing', 'scene');
+});
+
+test('exposure doubles linear values per stop', async () => {
   jobA = await showJob({ scene: 'cornell', width: 96, height: 72, spp: 16, max_depth: 5 });
-  // The course curve at exposure 0, from the float pixels, is image.png to within a level.
+  // A mapping or an exposure paints from the float pixels; the default view is the stream's PNG.
   await page.selectOption('#v-mapping', 'srgb');
   await page.waitForSelector('#v-tools[data-painted="srgb:0:false"]');
   await page.selectOption('#v-mapping', 'course');
