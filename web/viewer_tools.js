@@ -39,6 +39,7 @@ const REFETCH_MS = 2000;
 const tools = {
   data: null,        // {id, w, h, px: Float32Array (r, g, b, count) a pixel, min, max}
   stale: true,       // tiles arrived after the data was fetched
+  missing: null,     // a finished job whose pixels the server does not have: not asked again
   fetching: null,    // the request in flight
   lastFetch: 0,
   timer: null,
@@ -55,6 +56,7 @@ const tools = {
 
   reset() {
     this.data = null;
+    this.missing = null;
     this.stale = true;
     clearTimeout(this.timer);
     this.timer = null;
@@ -74,7 +76,7 @@ const tools = {
   // Fetches the pixels now, or once REFETCH_MS after the last fetch.
   request() {
     const id = viewer.id;
-    if (!id || this.fetching || this.timer) return;
+    if (!id || this.fetching || this.timer || this.missing === id) return;
     const wait = this.lastFetch + REFETCH_MS - performance.now();
     const ended = viewer.feed && viewer.feed.ended;
     if (wait > 0 && !ended) {
@@ -95,6 +97,11 @@ const tools = {
       res = await fetch(`/api/jobs/${id}/pixels`, { cache: 'no-store', headers: authHeaders() });
     } catch (e) {
       return;  // the connection indicator says so; the next tile asks again
+    }
+    if (res.status === 404 && viewer.feed && viewer.feed.ended && viewer.id === id) {
+      this.missing = id;
+      this.missingText = `No float pixels for this job: ${apiError({ status: 404, data: await res.json().catch(() => null) }).message}`;
+      $('#v-tools').dataset.data = 'missing';
     }
     if (!res.ok || viewer.id !== id) return;
     const w = Number(res.headers.get('X-Image-Width')), h = Number(res.headers.get('X-Image-Height'));
@@ -214,6 +221,10 @@ const tools = {
       return;
     }
     const d = this.data;
+    if (this.missing === viewer.id) {
+      out.textContent = this.missingText;
+      return;
+    }
     if (!d || d.id !== viewer.id) {
       out.textContent = `(${x}, ${y}) …`;
       this.request();

@@ -258,6 +258,23 @@ test('two jobs compare side by side and by wipe, with their differing settings l
   await page.locator('#compare').screenshot({ path: path.join(artifacts, 'web-viewer-compare.png') });
 });
 
+test('a finished job without float pixels says so once, and is not asked again', async () => {
+  let asked = 0;
+  await page.route('**/api/jobs/*/pixels', (route) => {
+    asked += 1;
+    return route.fulfill({ status: 404, contentType: 'application/json',
+      body: JSON.stringify({ error: { status: 404, message: "the job's sample counts are missing" } }) });
+  });
+  await page.click(`#job-rows tr[data-id="${jobA}"] [data-action="open"]`);
+  await page.waitForSelector('#v-tools[data-data="missing"]');
+  await page.locator('#v-canvas').scrollIntoViewIfNeeded();
+  const box = await page.locator('#v-canvas').boundingBox();
+  for (const f of [0.3, 0.5, 0.7]) await page.mouse.move(box.x + box.width * f, box.y + box.height * f);
+  await page.waitForFunction(() => /sample counts are missing/.test(document.querySelector('#v-readout').textContent));
+  assert.equal(asked, 1);
+  await page.unroute('**/api/jobs/*/pixels');
+});
+
 test('a narrow window needs no sideways scrolling with the tools and the comparison open', async () => {
   await page.setViewportSize({ width: 390, height: 844 });
   await page.waitForFunction(() => window.innerWidth === 390);
