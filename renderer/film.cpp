@@ -267,7 +267,7 @@ void Film::read_tile_rate(const Tile& t, std::vector<Vec3>& out) const {
 void Film::read_tile_count(const Tile& t, std::vector<uint32_t>& out) const {
   out.clear();
   for (int y = t.y0; y < t.y1; ++y)
-    for (int x = t.x0; x < t.x1; ++x) out.push_back(m_count[size_t(y) * m_w + x]);
+    out.insert(out.end(), m_count.begin() + size_t(y) * m_w + t.x0, m_count.begin() + size_t(y) * m_w + t.x1);
 }
 
 double Film::error_estimate(int threads) const {

@@ -217,7 +217,8 @@ class Film {
   // Mean radiance / rate colours of a tile's pixels, row by row. Safe while other tiles render.
   void read_tile(const Tile& t, std::vector<Vec3>& out) const;
   void read_tile_rate(const Tile& t, std::vector<Vec3>& out) const;
-  void read_tile_count(const Tile& t, std::vector<uint32_t>& out) const;  // samples taken
+  // Samples taken by each of a tile's pixels, row by row.
+  void read_tile_count(const Tile& t, std::vector<uint32_t>& out) const;
   // Estimated relative MSE of image() (halves_error_estimate), computed once for each state of the
   // statistics; call invalidate_estimate() after changing them.
   double error_estimate(int threads = 1) const;

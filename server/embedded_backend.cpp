@@ -49,8 +49,10 @@ class EmbeddedBackend : public RenderBackend {
 
     auto on_tile = [&](const pt::Tile& t) {
       thread_local std::vector<pt::Vec3> buf;
+      thread_local std::vector<uint32_t> count;
       session->film().read_tile(t, buf);
-      sink.tile(t, buf);
+      session->film().read_tile_count(t, count);
+      sink.tile(t, buf, count);
     };
     pt::ProgressEstimate estimate({job.spec.time_limit, job.spec.target_error});
     auto report = [&](double error) {

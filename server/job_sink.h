@@ -33,6 +33,7 @@ class JobStateSink : public JobSink {
       size_t n = size_t(width) * height;
       j.linear.assign(n * 3, 0.0f);
       j.display.assign(n * 3, 0);
+      j.counts.assign(n, 0);
       j.region_version.assign(size_t(j.regions_x) * j.regions_y, 0);
       // A resumed render keeps its history up to the checkpoint, and its counts (its first pass()
       // brings the checkpoint's): spp_done never drops to 0 on the way.
@@ -49,13 +50,14 @@ class JobStateSink : public JobSink {
     j.changed.notify_all();
   }
 
-  void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean) override {
+  void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean, const std::vector<uint32_t>& count) override {
     Job& j = m_job;
     {
       std::lock_guard<std::mutex> lock(j.mutex);
       size_t k = 0;
       for (int y = t.y0; y < t.y1; ++y)
         for (int x = t.x0; x < t.x1; ++x, ++k) {
+          j.counts[size_t(y) * j.width + x] = count[k];
           size_t i = (size_t(y) * j.width + x) * 3;
           for (int c = 0; c < 3; ++c) {
             j.linear[i + c] = mean[k][c];

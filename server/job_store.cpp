@@ -18,6 +18,21 @@
 
 namespace srv {
 
+std::string encode_sample_counts(const std::vector<uint32_t>& counts) {
+  std::string out(counts.size() * 4, '\0');
+  for (size_t i = 0; i < counts.size(); ++i)
+    for (int b = 0; b < 4; ++b) out[4 * i + b] = char((counts[i] >> (8 * b)) & 0xff);
+  return out;
+}
+
+bool decode_sample_counts(const std::string& bytes, size_t n, std::vector<uint32_t>& out) {
+  if (bytes.size() != n * 4) return false;
+  out.assign(n, 0);
+  for (size_t i = 0; i < n; ++i)
+    for (int b = 0; b < 4; ++b) out[i] |= uint32_t(uint8_t(bytes[4 * i + b])) << (8 * b);
+  return true;
+}
+
 bool read_file(const std::string& path, std::string& out, std::string* why) {
   auto fail = [&](const std::string& reason) {
     if (why) *why = reason;

@@ -3,8 +3,10 @@
 // retries of writes that failed for want of a file descriptor.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace srv {
 
@@ -14,6 +16,12 @@ namespace srv {
 bool read_file(const std::string& path, std::string& out, std::string* why = nullptr);
 // True when `path` is a regular file (not a link to one) of at least one byte.
 bool is_regular_file(const std::string& path);
+
+// A finished job's samples.bin: each pixel's sample count, uint32 little-endian, rows top to bottom
+// (what GET /pixels needs beside image.exr once the image is no longer in memory).
+std::string encode_sample_counts(const std::vector<uint32_t>& counts);
+// False when `bytes` is not `n` counts.
+bool decode_sample_counts(const std::string& bytes, size_t n, std::vector<uint32_t>& out);
 
 // Creates `path` and its parents; throws naming the folder and the system's reason (read-only file
 // system, permission denied, ...).

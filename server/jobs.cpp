@@ -473,6 +473,13 @@ void JobManager::store_images(Job& job, const RenderResult& result) {
   try {
     retry_without_descriptors([&] { pt::write_image(img, job_dir(job.id) + "/image.exr", meta); });
     retry_without_descriptors([&] { pt::write_image(img, job_dir(job.id) + "/image.png"); });
+    std::string counts;
+    {
+      std::lock_guard<std::mutex> lock(job.mutex);
+      if (job.counts.size() == img.pixels.size()) counts = encode_sample_counts(job.counts);
+    }
+    if (!counts.empty())
+      retry_without_descriptors([&] { write_file_atomic(job_dir(job.id) + "/samples.bin", counts); });
   } catch (const std::exception& e) {  // a full disk or a vanished data directory: the job fails, saying so
     std::string why = e.what(), dir = job_dir(job.id) + "/";
     for (size_t at; (at = why.find(dir)) != std::string::npos;) why.erase(at, dir.size());  // no server paths

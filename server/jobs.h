@@ -69,6 +69,7 @@ struct Job {
   int width = 0, height = 0, tile_size = 32, region_size = 64, regions_x = 0, regions_y = 0;
   std::vector<float> linear;
   std::vector<uint8_t> display;
+  std::vector<uint32_t> counts;          // samples taken by each pixel (GET /pixels, samples.bin)
   std::vector<uint64_t> region_version;  // the job version that last changed each region
   uint64_t passes = 0;                   // passes published so far (the whole-image PNG's cache key)
   bool has_image = false;

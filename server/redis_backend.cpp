@@ -376,8 +376,10 @@ class RedisBackend : public RenderBackend {
     const std::string fingerprint = pt::render_fingerprint(scene_text, spec.params);
     auto on_tile = [&](const pt::Tile& t) {
       thread_local std::vector<pt::Vec3> buf;
+      thread_local std::vector<uint32_t> count;
       passes.film().read_tile(t, buf);
-      sink.tile(t, buf);
+      passes.film().read_tile_count(t, count);
+      sink.tile(t, buf, count);
     };
     pt::ProgressEstimate estimate({spec.time_limit, spec.target_error});
     if (!plan.path.empty() && restore(plan.path, fingerprint, job, passes)) {

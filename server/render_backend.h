@@ -29,8 +29,9 @@ class JobSink {
   // Once, before any tile: the film size and the scene's feature set, and the rendering time a
   // checkpoint restored (0 for a fresh render). Throws if the job was cancelled meanwhile.
   virtual void started(int width, int height, const std::vector<std::string>& features, double resumed_seconds) = 0;
-  // A tile's pixels (mean radiance, row by row) changed. May be called from several threads.
-  virtual void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean) = 0;
+  // A tile's pixels (mean radiance and samples taken, row by row) changed. May be called from
+  // several threads.
+  virtual void tile(const pt::Tile& t, const std::vector<pt::Vec3>& mean, const std::vector<uint32_t>& count) = 0;
   // After each pass (a doubling pass, or a merged worker pass).
   virtual void pass(const RenderReport& r) = 0;
   // A checkpoint now holds `samples` taken in `seconds` of rendering: what a restart resumes from.

@@ -11,6 +11,7 @@
 
 #include "event_stream.h"
 #include "image.h"
+#include "job_store.h"
 #include "scene_file.h"
 #include "version.h"
 
@@ -196,6 +197,57 @@ void get_image(JobManager& jobs, const ApiOptions&, const Request& req, Response
   res.set_content(pt::encode_exr(img), type);  // outside the mutex the render threads take
 }
 
+// GET /api/jobs/{id}/pixels: the linear image as little-endian float32, (R, G, B, samples taken) a
+// pixel, rows top to bottom; its size in X-Image-Width / X-Image-Height. The page's viewer tools
+// (exposure, display mappings, the pixel readout, the sample-rate view) work on these exact values.
+void get_pixels(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
+  auto job = job_or_404(jobs, req);
+  int w = 0, h = 0;
+  std::vector<float> rgb;
+  std::vector<uint32_t> counts;
+  bool done;
+  std::string state;
+  {
+    std::lock_guard<std::mutex> lock(job->mutex);
+    done = job->state == JobState::done;
+    state = job_state_name(job->state);
+    if (job->has_image) {
+      w = job->width, h = job->height;
+      rgb = job->linear;
+      counts = job->counts;
+    }
+  }
+  if (w == 0) {
+    if (!done) throw HttpError(404, "job has no image yet (state " + state + ")");
+    // Finished before a restart: its files hold what the memory held.
+    const std::string dir = jobs.job_dir(job->id);
+    std::string bytes;
+    if (!is_regular_file(dir + "/image.exr")) throw HttpError(404, "the job's image is missing");
+    if (!read_file(dir + "/samples.bin", bytes)) throw HttpError(404, "the job's sample counts are missing");
+    const pt::ImageRGB img = pt::read_image(dir + "/image.exr");
+    if (!decode_sample_counts(bytes, img.pixels.size(), counts))
+      throw HttpError(404, "the job's sample counts do not fit its image");
+    w = img.width, h = img.height;
+    rgb.resize(img.pixels.size() * 3);
+    std::memcpy(rgb.data(), static_cast<const void*>(img.pixels.data()), rgb.size() * sizeof(float));
+  }
+  const size_t n = size_t(w) * h;
+  std::string body(n * 16, '\0');
+  auto put = [&body](size_t at, float v) {
+    uint32_t bits;
+    std::memcpy(&bits, &v, 4);
+    for (int b = 0; b < 4; ++b) body[at + b] = char((bits >> (8 * b)) & 0xff);
+  };
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) put(16 * i + 4 * c, rgb[3 * i + c]);
+    put(16 * i + 12, float(counts[i]));
+  }
+  res.set_header("Cache-Control", "no-store");
+  res.set_header("X-Image-Width", std::to_string(w));
+  res.set_header("X-Image-Height", std::to_string(h));
+  res.set_content(body, "application/octet-stream");
+}
+
 void get_focus(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
   auto job = job_or_404(jobs, req);
   auto coord = [&](const char* name) {
@@ -246,6 +298,7 @@ const Route kRoutes[] = {
     {"POST", "/api/jobs/([^/]+)/resume", resume_job},
     {"POST", "/api/jobs/([^/]+)/continue", continue_job},
     {"GET", "/api/jobs/([^/]+)/image\\.(png|exr)", get_image},
+    {"GET", "/api/jobs/([^/]+)/pixels", get_pixels},
     {"GET", "/api/jobs/([^/]+)/focus", get_focus},
     {"GET", "/api/jobs/([^/]+)/events", watch_job},
 };

@@ -1,16 +1,34 @@
 // The render-job page: a form that validates against /api/jobs/check, a viewer fed by the job's
 // event stream (tiles paint as they arrive), click-to-focus, and the wiring. No framework, no
-// build step: common.js (state, API), feed.js (a job's event stream), chart.js, sweep.js and
-// jobs.js (the job list) load before this file (index.html), as plain scripts sharing their
-// top-level names.
+// build step: common.js (state, API), feed.js (a job's event stream), chart.js, sweep.js, jobs.js
+// (the job list), viewer_tools.js (exposure, mappings, zoom, readout) and compare.js load before
+// this file (index.html), as plain scripts sharing their top-level names.
 'use strict';
 
 // Form fields: name -> kind. The input of field F is #f-F and its error line is #err-F.
 const FIELDS = {
   scene: 'select', max_depth: 'int', light_samples: 'int', aperture: 'num', focal_distance: 'num',
   spp: 'int', width: 'int', height: 'int', seed: 'int', time_limit: 'num', target_error: 'num', adaptive: 'bool',
-  adaptive_tolerance: 'num', keep_fov: 'bool', caustic_tracing: 'bool',
+  adaptive_tolerance: 'num', caustic_tracing: 'bool',
 };
+
+// The framing select sets two job fields (the API refuses both true): value -> fields, and what it does.
+const FRAMINGS = {
+  scene: { frame_scene: true, keep_fov: false, hint: 'The course\'s view direction, zoomed so the scene fills the image.' },
+  crop: { frame_scene: false, keep_fov: false, hint: 'As the course renders: a pixel keeps its angle, and a smaller image shows the centre of the view.' },
+  whole: { frame_scene: false, keep_fov: true, hint: 'The course\'s whole view, scaled to this size.' },
+};
+const FRAMING_FIELDS = ['frame_scene', 'keep_fov'];  // their errors show beside the select
+
+function framingOf(spec) {
+  if (spec.frame_scene) return 'scene';
+  return spec.keep_fov ? 'whole' : 'crop';
+}
+
+function showFramingHint() {
+  const f = FRAMINGS[$('#f-framing').value];
+  $('#framing-hint').textContent = f ? `${f.hint} COLLADA scenes; a glTF scene keeps its own camera.` : '';
+}
 
 // ---------- the main viewer ----------
 
@@ -32,6 +50,7 @@ const viewer = {
     this.feed = null;
     this.fillPending = fill;
     this.moreFor = null;
+    tools.reset();
     $('#v-marker').hidden = true;
     this.note('');
     history.replaceState(null, '', id ? `#job=${id}` : '#');
@@ -70,11 +89,13 @@ const viewer = {
       clearCanvas(canvas, feed.canvas.width, feed.canvas.height);
       fitStage();
     } else if (type === 'pixels') {
-      syncCanvas(canvas, feed, rect);
+      if (!tools.active()) syncCanvas(canvas, feed, rect);  // else the tools paint from the float pixels
+      tools.onPixels(feed.ended);
       $('#v-placeholder').hidden = true;
       $('#viewer').dataset.tiles = String(feed.tiles);
     } else if (type === 'status') {
       this.renderStatus(feed.status);
+      if (tools.rate) tools.showLegend();
     } else if (type === 'conn') {
       $('#viewer').dataset.conn = feed.conn;
     } else if (type === 'history') {
@@ -83,6 +104,7 @@ const viewer = {
       $('#viewer').dataset.ended = 'false';
     } else if (type === 'end') {
       $('#viewer').dataset.ended = 'true';
+      if (feed.painted) tools.onPixels(true);
       const st = feed.status && feed.status.state;
       if (!feed.painted) {
         $('#v-placeholder').textContent = st === 'cancelled' ? 'No image: the job was cancelled.'
@@ -185,6 +207,7 @@ function fitStage() {
   requestAnimationFrame(() => {
     const scale = wrap.clientWidth / w;
     canvas.style.imageRendering = scale >= 2 ? 'pixelated' : 'auto';
+    tools.applyZoom();
   });
 }
 
@@ -201,8 +224,9 @@ async function focusAt(ev) {
   const px = Math.min(canvas.width - 1, Math.floor(fx * canvas.width)) + 0.5;
   const py = Math.min(canvas.height - 1, Math.floor(fy * canvas.height)) + 0.5;
   const marker = $('#v-marker');
-  marker.style.left = `${fx * 100}%`;
-  marker.style.top = `${fy * 100}%`;
+  const wrap = $('#v-wrap').getBoundingClientRect();  // the canvas may be zoomed and panned inside it
+  marker.style.left = `${((ev.clientX - wrap.left) / wrap.width) * 100}%`;
+  marker.style.top = `${((ev.clientY - wrap.top) / wrap.height) * 100}%`;
   marker.hidden = false;
   marker.classList.remove('pulse');
   void marker.offsetWidth;
@@ -253,6 +277,8 @@ function readSpec() {
     else if (el.validity && el.validity.badInput) errors[name] = 'Enter a number.';
     else if (el.value.trim() !== '') spec[name] = Number(el.value);
   }
+  const framing = FRAMINGS[$('#f-framing').value];
+  for (const name of FRAMING_FIELDS) spec[name] = framing[name];
   return { spec, errors };
 }
 
@@ -262,6 +288,7 @@ function clearErrors() {
 }
 
 function showError(field, message) {
+  if (FRAMING_FIELDS.includes(field)) field = 'framing';
   const line = field && document.getElementById(`err-${field}`);
   if (line) {
     line.textContent = message;
@@ -271,8 +298,15 @@ function showError(field, message) {
     const details = line.closest('details');
     if (details) details.open = true;
   } else {
-    $('#err-form').textContent = message;
+    const form = $('#err-form');
+    form.textContent = form.textContent ? `${form.textContent} ${message}` : message;
   }
+}
+
+// Marks every field an error answer names (all of error.errors, else error.field).
+function showApiErrors(e, prefix = '') {
+  const list = e.errors && e.errors.length ? e.errors : [{ field: e.field, message: e.message }];
+  for (const x of list) showError(x.field, prefix + x.message);
 }
 
 function showClientErrors(errors) {
@@ -300,8 +334,7 @@ async function checkForm() {
     const n = new Intl.NumberFormat('en', { notation: 'compact', maximumFractionDigits: 1 }).format(s.width * s.height * s.spp);
     $('#check-state').textContent = `✓ ${n} samples`;
   } else {
-    const e = apiError(r);
-    showError(e.field, e.message);
+    showApiErrors(apiError(r));
   }
 }
 
@@ -318,8 +351,7 @@ async function submitJob(ev) {
     const r = await postJson('/api/jobs', spec, { 'Idempotency-Key': randomKey() });
     clearErrors();
     if (!r || !r.ok) {
-      const e = apiError(r);
-      showError(e.field, e.message);
+      showApiErrors(apiError(r));
       return;
     }
     viewer.show(r.data.id);
@@ -359,6 +391,8 @@ function fillForm(spec) {
     if (kind === 'bool') el.checked = !!spec[name];
     else el.value = spec[name] === null ? '' : String(spec[name]);
   }
+  $('#f-framing').value = framingOf(spec);
+  showFramingHint();
   showSceneSummary();
   scheduleCheck();
 }
@@ -388,8 +422,9 @@ async function loadScenes() {
       else el.value = String(state.defaults[name]);
       if (kind !== 'bool') el.placeholder = String(state.defaults[name]);
     }
-    // The API keeps the course's cropping by default; on the page a small image shows the whole view.
-    input('keep_fov').checked = true;
+    // The API keeps the course's cropping by default; on the page the scene fills the image.
+    $('#f-framing').value = 'scene';
+    showFramingHint();
   }
   showSceneSummary();
   return true;
@@ -406,6 +441,7 @@ function init() {
   });
   form.addEventListener('change', (e) => {
     if (e.target.id === 'f-scene') showSceneSummary();
+    if (e.target.id === 'f-framing') showFramingHint();
     scheduleCheck();
   });
   $('#use-center').addEventListener('click', (e) => {
@@ -434,6 +470,8 @@ function init() {
   });
   initJobs();
   initUpload();
+  initViewerTools();
+  initCompare();
   let resizeTimer = null;
   window.addEventListener('resize', () => {
     clearTimeout(resizeTimer);

@@ -109,10 +109,15 @@ function postJson(path, body, headers = {}) {
   return api(path, { method: 'POST', headers: { 'Content-Type': 'application/json', ...headers }, body: JSON.stringify(body) });
 }
 
+// An error answer as {message, field, errors}: `errors` lists every invalid field ({field,
+// message}) where the server sent error.errors, else the one error.field / error.message.
 function apiError(r) {
-  if (!r) return { message: 'The server cannot be reached.' };
+  if (!r) return { message: 'The server cannot be reached.', errors: [] };
   const e = r.data && r.data.error;
-  return e ? { message: e.message, field: e.field } : { message: `The server answered ${r.status}.` };
+  if (!e) return { message: `The server answered ${r.status}.`, errors: [] };
+  const list = Array.isArray(e.errors) && e.errors.length ? e.errors.filter((x) => x && x.message)
+    : [{ field: e.field, message: e.message }];
+  return { message: e.message, field: e.field, errors: list };
 }
 
 function decodePng(b64) {

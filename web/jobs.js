@@ -13,6 +13,8 @@ const OTHER_SETTINGS = [
   ['time_limit', (v) => `limit ${v} s`],
   ['seed', (v) => `seed ${v}`],
   ['caustic_tracing', (v) => (v ? 'caustics' : 'no caustics')],
+  ['frame_scene', (v) => (v ? 'fitted to the scene' : 'course framing')],
+  ['keep_fov', (v) => (v ? 'whole course view' : 'course crop')],
 ];
 
 // The columns after Job and Created: [class, text of a job, key compared between neighbours or null].
@@ -67,7 +69,8 @@ function rowFor(id) {
     '<button type="button" data-action="pause">Pause</button><button type="button" data-action="resume">Resume</button>' +
     '<button type="button" data-action="cancel" class="danger">Cancel</button>' +
     '<button type="button" data-action="delete" class="danger" title="Delete the job and its images">Delete</button>' +
-    '<a class="button" data-action="png">PNG</a><a class="button" data-action="exr">EXR</a></td>';
+    '<a class="button" data-action="png">PNG</a><a class="button" data-action="exr">EXR</a>' +
+    '<label class="compare-pick" title="Compare two jobs: the first picked is A"><input type="checkbox" data-action="compare"> compare</label></td>';
   jobList.rows.set(id, tr);
   return tr;
 }
@@ -112,6 +115,7 @@ function renderJobs(jobs) {
     if (!seen.has(id)) { tr.remove(); jobList.rows.delete(id); }
   }
   markDifferences(jobs);
+  syncComparePicks();
   $('#jobs-empty').hidden = jobs.length > 0;
   $('#jobs-more').hidden = !jobList.more;
   highlightRow();
@@ -244,7 +248,7 @@ function onReconnected() {
 function initJobs() {
   $('#job-rows').addEventListener('click', (e) => {
     const b = e.target.closest('[data-action]');
-    if (!b || b.tagName === 'A') return;
+    if (!b || b.tagName === 'A' || b.tagName === 'INPUT') return;  // links; compare boxes: compare.js
     const id = b.closest('tr').dataset.id;
     if (b.dataset.action === 'open') viewer.show(id, { fill: true });
     else if (b.dataset.action === 'delete') armDelete(b, id);

@@ -41,15 +41,13 @@ async function runSweep(kind) {
   try {
     const first = await postJson('/api/jobs/check', { ...base, [key]: values[0] });
     if (!first || !first.ok) {
-      const e = apiError(first);
-      return showError(e.field, e.message);
+      return showApiErrors(apiError(first));
     }
     const ids = [];
     for (const v of values) {
       const r = await postJson('/api/jobs', { ...base, [key]: v }, { 'Idempotency-Key': randomKey() });
       if (!r || !r.ok) {
-        const e = apiError(r);
-        showError(e.field, `Sweep stopped after ${ids.length} of 4 jobs: ${e.message}`);
+        showApiErrors(apiError(r), `Sweep stopped after ${ids.length} of 4 jobs: `);
         break;
       }
       ids.push({ id: r.data.id, label: `${key === 'aperture' ? 'aperture' : 'focus'} ${v}` });
@@ -69,7 +67,8 @@ class SweepCell {
     this.el.dataset.id = id;
     this.el.dataset.state = 'queued';
     this.el.innerHTML = '<button type="button" class="cell-open" title="Open in the viewer"><canvas></canvas></button>' +
-      '<figcaption><span class="cell-label"></span><span class="cell-state"></span></figcaption>' +
+      '<figcaption><span class="cell-label"></span><span class="cell-state"></span>' +
+      '<label class="compare-pick"><input type="checkbox" data-action="compare"> compare</label></figcaption>' +
       '<div class="progress mini"><div class="bar"></div></div>';
     this.canvas = this.el.querySelector('canvas');
     this.el.querySelector('.cell-label').textContent = label;
@@ -103,6 +102,7 @@ function showSweep(title, sub, jobs) {
   const grid = $('#sweep-grid');
   state.sweepCells = jobs.map((j) => new SweepCell(j.id, j.label));
   state.sweepCells.forEach((c) => grid.appendChild(c.el));
+  syncComparePicks();
   $('#sweep').hidden = false;
   $('#sweep').scrollIntoView({ behavior: 'smooth', block: 'nearest' });
 }

@@ -130,7 +130,7 @@ def test_what_a_crash_can_leave_is_cleaned_up_at_start(servers):
     (jobs / "0000000000000000").mkdir()
     (jobs / b["id"] / "image.png").write_bytes(b"")
     srv = servers("planted", threads=2)
-    assert sorted(p.name for p in (jobs / a["id"]).iterdir()) == ["checkpoint.bin", "image.exr", "image.png", "job.json"]
+    assert sorted(p.name for p in (jobs / a["id"]).iterdir()) == ["checkpoint.bin", "image.exr", "image.png", "job.json", "samples.bin"]
     assert not (jobs / "0000000000000000").exists()
     assert "removed 2 temp files" in srv.log_text()
     assert [j["id"] for j in srv.api.get("/api/jobs").json()["jobs"]] == [b["id"], a["id"]]  # newest first

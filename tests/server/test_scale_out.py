@@ -9,6 +9,7 @@ import re
 import shutil
 import signal
 import socket
+import struct
 import subprocess
 import time
 from pathlib import Path
@@ -183,6 +184,9 @@ def test_killed_worker_loses_nothing_and_image_matches_single_process(cluster, s
             worst = max(worst, abs(a - b) / (abs(b) + 1e-3))
     assert worst < 1e-3, f"distributed and single-process images differ by up to {worst:.2e} (relative)"
     assert done["error_estimate"] is not None and done["error_estimate"] > 0
+    # Each pixel's sample count reaches /pixels through the merges too: they add up to the job's.
+    counts = struct.unpack(f"<{w * h * 4}f", api.get(f"/api/jobs/{job_id}/pixels").content)[3::4]
+    assert sum(counts) == done["samples"] and min(counts) >= 1
 
 
 def test_events_stream_merged_passes_and_adaptive_converges(cluster):

@@ -95,6 +95,32 @@ test('a bad value is explained next to its field', async () => {
   await page.waitForFunction(() => document.querySelector('#err-width').textContent === '');
 });
 
+// The API may list every invalid field (error.errors) or name the first (error.field): the form
+// marks each field named, whichever shape the answer has.
+test('every invalid field an error answer lists is marked at once', async () => {
+  const answers = [
+    { status: 400, message: 'spp must be at least 1', field: 'spp',
+      errors: [{ field: 'spp', message: 'spp must be at least 1' }, { field: 'width', message: 'width must be at most 4096' }] },
+    { status: 400, message: 'height must be at least 1', field: 'height' },
+  ];
+  for (const error of answers) {
+    await page.route('**/api/jobs/check', (route) =>
+      route.fulfill({ status: 400, contentType: 'application/json', body: JSON.stringify({ error }) }));
+    await page.evaluate(() => checkForm());
+    const listed = error.errors || [error];
+    await page.waitForFunction((fields) => fields.every((f) => document.querySelector(`#f-${f}`).getAttribute('aria-invalid') === 'true'),
+      listed.map((e) => e.field));
+    for (const e of listed) assert.equal(await page.textContent(`#err-${e.field}`), e.message);
+    assert.equal(await page.$$eval('#job-form [aria-invalid="true"]', (els) => els.length), listed.length);
+    await page.unroute('**/api/jobs/check');
+  }
+  // The server's own answer names both fields at once.
+  await fill({ spp: 0, width: 100000 });
+  await page.waitForFunction(() => ['spp', 'width'].every((f) => document.querySelector(`#f-${f}`).getAttribute('aria-invalid') === 'true'));
+  await fill({ spp: 8, width: 96 });
+  await page.waitForFunction(() => !document.querySelector('#job-form [aria-invalid]'));
+});
+
 test('tiles stream into the canvas and match the final image; cancel stops a job', async () => {
   // A long job holds the (one-at-a-time) renderer, so the small job's stream is open before it renders.
   const longJob = await submit({ scene: 'cornell', width: 320, height: 240, spp: 4096 });
