@@ -144,6 +144,7 @@ const viewer = {
     if (s.state === 'done' && s.stopped && s.stopped !== 'finished') text += ` · ${s.stopped}`;
     if (s.state === 'failed') text = `failed${s.message ? `: ${s.message}` : ''}`;
     $('#v-progress-text').textContent = text;
+    showWarnings($('#v-warnings'), s.warnings);
     $('#v-spp').textContent = `${fmtNum(s.spp_done, 3)} / ${spec.spp}`;
     $('#v-spp').title = `${Number(s.samples || 0).toLocaleString()} samples taken`;
     $('#v-elapsed').textContent = fmtDuration(s.elapsed);
@@ -367,6 +368,7 @@ function showSceneSummary() {
   const sc = state.scenes.find((s) => s.name === $('#f-scene').value);
   const el = $('#scene-summary');
   const btn = $('#use-center');
+  showWarnings($('#scene-warnings'), sc && sc.summary && sc.summary.warnings);
   if (!sc || !sc.summary) { el.textContent = ''; btn.hidden = true; return; }
   const s = sc.summary;
   const parts = [];

@@ -145,3 +145,14 @@ function connectionLost() {
   updateConn();
   schedulePoll(1000);
 }
+
+// What a scene's loader ignored or defaulted (a scene summary's or a job's `warnings`), as a
+// collapsed list under `el` (a <details> with a <summary> and a <ul>); hidden when there is none.
+function showWarnings(el, warnings) {
+  const list = Array.isArray(warnings) ? warnings : [];
+  el.hidden = list.length === 0;
+  el.querySelector('summary').textContent =
+    `${list.length} loader warning${list.length === 1 ? '' : 's'}: what the scene file asks for that is not rendered as written`;
+  const ul = el.querySelector('ul');
+  ul.replaceChildren(...list.map((w) => Object.assign(document.createElement('li'), { textContent: w })));
+}

@@ -228,6 +228,17 @@ test('a scene uploaded with the file picker is summarised, selected and renders;
   assert.match(await page.textContent('#scene-summary'), /triangles/);
   await submit({ scene: 'box', spp: 2, width: 32, height: 24 });
   await waitViewerEnded('done');
+  assert.ok(await page.isHidden('#v-warnings'), 'a scene without loader warnings shows none');
+  // A scene the loader warns about (no camera): the warnings show with its summary and with its job.
+  const noCamera = Buffer.from(cornell.toString().replace(/<instance_camera url="[^"]*"\/>/, ''));
+  await page.setInputFiles('#f-upload', { name: 'nocam.dae', mimeType: 'model/vnd.collada+xml', buffer: noCamera });
+  await page.waitForFunction(() => /Scene 'nocam' uploaded/.test(document.querySelector('#upload-status').textContent));
+  assert.match(await page.textContent('#scene-warnings summary'), /^1 loader warning:/);
+  assert.match(await page.textContent('#scene-warnings li'), /^nocam\.dae:\d+: .*no <instance_camera>/);
+  await submit({ scene: 'nocam', spp: 2, width: 32, height: 24 });
+  await waitViewerEnded('done');
+  assert.match(await page.textContent('#v-warnings li'), /no <instance_camera>/);
+  assert.ok(await page.isVisible('#v-warnings'));
 });
 
 test('no uncaught errors on the page', () => {
