@@ -36,7 +36,7 @@ TEST(ViewerCli, HelpListsTheWindowKeys) {
   RunResult r = run("--help");
   EXPECT_EQ(r.status, 0);
   EXPECT_NE(r.output.find("Window keys"), std::string::npos);
-  for (const char* k : {"R ", ". / ,", "L / K", "' / ;", "] / [", "= / -", "T ", "S ", "D ", "click", "` ", "H ",
+  for (const char* k : {"R ", ". / ,", "L / K", "' / ;", "] / [", "= / -", "T ", "S ", "D ", "click", "H (or `)", "? (/)",
                         "Esc / Q", "--script", "--output-dir"})
     EXPECT_NE(r.output.find(k), std::string::npos) << k;
 }
@@ -122,7 +122,7 @@ key -
 overlay
 key R
 key T
-key H
+key ?
 quit
 )");
   const std::string& o = r.output;

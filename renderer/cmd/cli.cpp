@@ -262,8 +262,8 @@ std::string window_keys_text() {
 "                  in the current directory (or --output-dir)\n"
 "  D               write the camera settings to <scene>_cam_settings.txt (there too)\n"
 "  click           focus the thin lens on the surface under the cursor (autofocus)\n"
-"  `               show / hide the status panel (samples, error, ETA, settings)\n"
-"  H               list these keys (in the panel and on stdout)\n"
+"  H (or `)        show / hide the status panel (samples, error, ETA, settings)\n"
+"  ? (/)           list these keys (in the panel and on stdout)\n"
 "  Esc / Q         quit\n";
 }
 

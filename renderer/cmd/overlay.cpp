@@ -122,7 +122,7 @@ std::vector<std::string> status_lines(const Status& st, const RenderParams& p, b
   l.push_back("focal dist " + fmt_g(p.focal_distance));
   l.push_back("light samples " + std::to_string(p.light_samples));
   l.push_back(rate_view ? "view sample rate" : "view radiance");
-  l.push_back("H keys, ` hide");
+  l.push_back("H hide, ? keys");
   return l;
 }
 

@@ -145,7 +145,7 @@ class Viewer {
   }
 
   void on_key(int key, bool repeat) {
-    if (key != GLFW_KEY_H) set_show_keys(false);
+    if (key != GLFW_KEY_SLASH) set_show_keys(false);
     switch (key) {
       case GLFW_KEY_ESCAPE:
       case GLFW_KEY_Q: glfwSetWindowShouldClose(m_win, GLFW_TRUE); break;
@@ -195,13 +195,14 @@ class Viewer {
         break;
       case GLFW_KEY_S: push_command({CommandKind::save}); break;
       case GLFW_KEY_D: write_camera(); break;
-      case GLFW_KEY_H:
+      case GLFW_KEY_SLASH:  // '?' on most layouts
         set_show_keys(!m_show_keys);
         if (m_show_keys) {
           std::printf("Window keys:\n%s", window_keys_text().c_str());
           std::fflush(stdout);
         }
         break;
+      case GLFW_KEY_H:             // the course's H toggles hemisphere sampling: that is the -H flag here
       case GLFW_KEY_GRAVE_ACCENT:  // the course's key for its on-screen info text
         m_show_panel = !m_show_panel;
         m_dirty = true;

@@ -27,6 +27,8 @@ int key_code(const std::string& name) {
     case '=': return GLFW_KEY_EQUAL;
     case '-': return GLFW_KEY_MINUS;
     case '`': return GLFW_KEY_GRAVE_ACCENT;
+    case '/':
+    case '?': return GLFW_KEY_SLASH;
     default: return -1;
   }
 }
