@@ -9,7 +9,11 @@ cd "$(dirname "$0")/.."
 root=$PWD
 build_only=0
 if [ "${1:-}" = --build-only ]; then build_only=1; shift; fi
-export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:abort_on_error=0:detect_stack_use_after_return=1:check_initialization_order=1:strict_init_order=1"
+# intercept_tls_get_addr=0: with it on, LeakSanitizer reads a bogus dynamic-TLS range of a library
+# the image module loads and its tracer crashes at exit ("Tracer caught signal 11", "DTLS 14 at
+# 0x1d4e-0x800002e50"; google/sanitizers#1353), after tests that pass (Features.ParametersAddTheirFeatures
+# every time). Leaks are still found: only the dynamic-TLS blocks are not scanned as roots.
+export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:abort_on_error=0:detect_stack_use_after_return=1:check_initialization_order=1:strict_init_order=1:intercept_tls_get_addr=0"
 export LSAN_OPTIONS="suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0"
 export PT_SANITIZED=1  # tests/server/test_load.py allows for the allocator's quarantine
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:suppressions=$root/tests/sanitizers/ubsan.supp"
@@ -27,15 +31,4 @@ ln -sfn ../build/venv build-asan/venv
 cd build-asan
 # The window (Mesa under Xvfb) and web (Chromium) tests exercise uninstrumented code at length:
 # left to the plain build.
-log=$(mktemp)
-trap 'rm -f "$log"' EXIT
-if ctest --output-on-failure --timeout 900 -j "$(nproc)" -LE '^(window|web)$' "$@" 2>&1 | tee "$log"; then exit 0; fi
-# LSan's own stop-the-world tracer crashes now and then at process exit, after every test in the
-# process passed and before any leak is looked for ("Tracer caught signal 11", google/sanitizers#1353).
-# Failures that are that and nothing else are run once more; any other failure fails the run.
-if python3 "$root/scripts/lsan_tracer_only.py" "$log"; then
-  echo "asan.sh: only LeakSanitizer tracer crashes failed; running those tests once more"
-  ctest --rerun-failed --output-on-failure --timeout 900 -j "$(nproc)"
-else
-  exit 1
-fi
+ctest --output-on-failure --timeout 900 -j "$(nproc)" -LE '^(window|web)$' "$@"

@@ -232,6 +232,8 @@ void get_pixels(JobManager& jobs, const ApiOptions&, const Request& req, Respons
     std::memcpy(rgb.data(), static_cast<const void*>(img.pixels.data()), rgb.size() * sizeof(float));
   }
   const size_t n = size_t(w) * h;
+  if (rgb.size() != 3 * n || counts.size() != n)  // never expected: a job's arrays are sized together
+    throw HttpError(404, "the job's pixels and sample counts do not match its size");
   std::string body(n * 16, '\0');
   auto put = [&body](size_t at, float v) {
     uint32_t bits;
