@@ -71,12 +71,17 @@ export function makeDataDir(name) {
   return fs.mkdtempSync(path.join(os.tmpdir(), `${name}-`));
 }
 
+// Headless Chromium (no sandbox as root, which Chromium refuses otherwise).
+export async function launchBrowser() {
+  const args = ['--disable-dev-shm-usage'];
+  if (process.getuid && process.getuid() === 0) args.push('--no-sandbox');
+  return chromium.launch({ executablePath: chromiumPath, headless: true, args });
+}
+
 // Headless Chromium and one page on `url`, the server's connection live and its scenes listed;
 // uncaught page errors are pushed onto `errors`.
 export async function openBrowser(url, errors) {
-  const args = ['--disable-dev-shm-usage'];
-  if (process.getuid && process.getuid() === 0) args.push('--no-sandbox');
-  const browser = await chromium.launch({ executablePath: chromiumPath, headless: true, args });
+  const browser = await launchBrowser();
   const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
   page.setDefaultTimeout(WAIT);
   page.on('pageerror', (e) => errors.push(e.message));

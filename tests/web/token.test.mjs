@@ -2,59 +2,25 @@
 // driven by playwright-core): the token given in the address's fragment (#token=...) is taken out
 // of the address bar and sent on every API call, in the event stream's query (EventSource cannot
 // send headers) and in the image links; without it the page asks for it once and then works.
-// Same environment and skip rules (exit 77; under CI=true, 1) as page.test.mjs.
+// Same environment and skip rules (exit 77; under CI=true, 1) as every page test (harness.mjs).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
-import os from 'node:os';
-import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { skip } from './missing.mjs';
+import { WAIT, launchBrowser, makeDataDir, startServer, stopServer, waitReady } from './harness.mjs';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const sourceDir = path.resolve(process.env.PT_SOURCE_DIR || path.join(here, '..', '..'));
-const serverBin = process.env.RENDER_SERVER || path.join(sourceDir, 'build', 'render-server');
-const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
-const WAIT = Number(process.env.PT_WEB_WAIT_MS) || 90_000;
 const TOKEN = 'web-t0ken&with=odd#chars';
-
-if (!fs.existsSync(serverBin)) skip(`no render-server at ${serverBin}`);
-if (!fs.existsSync(chromiumPath)) skip(`no browser at ${chromiumPath} (apt-get install chromium)`);
-let chromium;
-try {
-  ({ chromium } = await import('playwright-core'));
-} catch (e) {
-  skip(`playwright-core is not installed (run npm ci in ${here}): ${e.message}`);
-}
 
 let dataDir, server, baseUrl, browser;
 
 before(async () => {
-  dataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'web-token-test-'));
-  server = spawn(serverBin, ['--port', '0', '--data', dataDir, '--web', path.join(sourceDir, 'web'), '--token', TOKEN],
-    { stdio: ['ignore', 'pipe', 'inherit'] });
-  baseUrl = await new Promise((resolve, reject) => {
-    let out = '';
-    const timer = setTimeout(() => reject(new Error(`render-server did not start: ${out}`)), 20_000);
-    server.stdout.on('data', (d) => {
-      out += d;
-      const m = out.match(/listening on (http:\/\/127\.0\.0\.1:\d+\/)/);
-      if (m) {
-        clearTimeout(timer);
-        resolve(m[1]);
-      }
-    });
-    server.on('exit', (code) => reject(new Error(`render-server exited (${code}): ${out}`)));
-  });
-  const args = ['--disable-dev-shm-usage'];
-  if (process.getuid && process.getuid() === 0) args.push('--no-sandbox');
-  browser = await chromium.launch({ executablePath: chromiumPath, headless: true, args });
+  dataDir = makeDataDir('web-token-test');
+  ({ proc: server, url: baseUrl } = await startServer(dataDir, 0, ['--token', TOKEN]));
+  browser = await launchBrowser();
 });
 
 after(async () => {
   if (browser) await browser.close();
-  if (server) server.kill('SIGKILL');
+  if (server) await stopServer(server);
   if (dataDir) fs.rmSync(dataDir, { recursive: true, force: true });
 });
 
@@ -70,8 +36,7 @@ async function newPage() {
 }
 
 async function renderOne(page) {
-  await page.waitForSelector('#conn[data-state="live"]');
-  await page.waitForSelector('#f-scene option[value="cornell"]', { state: 'attached' });
+  await waitReady(page);
   for (const [k, v] of Object.entries({ width: 320, height: 240, spp: 64 })) await page.fill(`#f-${k}`, String(v));
   const before = await page.evaluate(() => (location.hash.match(/job=([0-9a-f]+)/) || [])[1]);
   await page.click('#submit');
