@@ -14,8 +14,8 @@ are compared with the best of them, the one with the highest efficiency on that 
 the course's CBspheres, CBbunny and CBdragon (../shared) and our dof.dae through a thin lens
 (-b 0.12 -d 3.6), all at depth 5.
 
-Mitsuba comes from PyPI into build/mitsuba-venv (mitsuba 3.5.2: later Dr.Jit versions emit LLVM IR
-that needs LLVM 16 or newer, and Debian 12 ships 14 and 15; Dr.Jit finds Debian's libLLVM through
+Mitsuba comes from PyPI into build/mitsuba-venv (mitsuba 3.9.1; its Dr.Jit emits LLVM IR that needs
+LLVM 16 or newer: Debian 12's libllvm19 or libllvm16, found and handed to Dr.Jit through
 DRJIT_LIBLLVM_PATH). `build/bench_export_mitsuba` writes each scene as our loader sees it (world
 triangles as PLY, spheres, materials, area lights, the comparison framing's camera: the course's
 view at 480x360, keep_fov). Both renderers: 2 threads, one light sample, no adaptive sampling, a
@@ -49,7 +49,8 @@ SHARED = ROOT.parent / "shared" / "scenes-cs184"
 SCENES = {"CBspheres": (SHARED / "CBspheres.dae", 5, 0.0, 4.7), "CBbunny": (SHARED / "CBbunny.dae", 5, 0.0, 4.7),
           "CBdragon": (SHARED / "CBdragon.dae", 5, 0.0, 4.7), "dof": (ROOT / "scenes" / "dof.dae", 5, 0.12, 3.6)}
 SAMPLERS = ("multijitter", "ldsampler", "independent")
-MITSUBA = "mitsuba==3.5.2"
+MITSUBA_VERSION = "3.9.1"
+MITSUBA = f"mitsuba=={MITSUBA_VERSION}"
 
 
 def ensure_venv():
@@ -57,7 +58,9 @@ def ensure_venv():
     py = VENV / "bin" / "python"
     if Path(sys.prefix).resolve() == VENV.resolve():
         return
-    if not py.exists() or subprocess.run([str(py), "-c", "import mitsuba, numpy"], capture_output=True).returncode:
+    if not py.exists() or subprocess.run(
+            [str(py), "-c", f"import mitsuba, numpy; assert mitsuba.__version__ == '{MITSUBA_VERSION}'"],
+            capture_output=True).returncode:
         print(f"vs_mitsuba: installing {MITSUBA} and numpy into {VENV}", file=sys.stderr)
         subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
         subprocess.run([str(py), "-m", "pip", "install", "-q", MITSUBA, "numpy"], check=True)
@@ -65,7 +68,8 @@ def ensure_venv():
 
 
 def find_libllvm():
-    for pattern in ("libLLVM-15.so*", "libLLVM-14.so*"):
+    """A libLLVM new enough for Mitsuba's Dr.Jit (16 or newer), the newest first."""
+    for pattern in ("libLLVM-19.so*", "libLLVM.so.19*", "libLLVM-16.so*", "libLLVM.so.16*"):
         for base in (Path("/usr/lib/x86_64-linux-gnu"), Path("/usr/lib/aarch64-linux-gnu")):
             hits = sorted(base.glob(pattern))
             if hits:
@@ -206,7 +210,8 @@ def main():
         sys.exit(f"vs_mitsuba: --profile: {why_not}")
     llvm = find_libllvm()
     if not llvm:
-        sys.exit("vs_mitsuba: no libLLVM 14/15 found (Debian: libllvm15); Mitsuba's llvm variant needs it")
+        sys.exit("vs_mitsuba: no libLLVM 16 or newer found (Debian 12: apt install libllvm19); "
+                 "Mitsuba's llvm variant needs it")
     os.environ.setdefault("DRJIT_LIBLLVM_PATH", llvm)
     ensure_venv()
     import numpy as np
@@ -236,7 +241,7 @@ def main():
         steps = len(samplers) * args.runs + args.runs
         # Mitsuba: its reference (cached), then per sampler one warm-up render (kernel compilation)
         # and the timed runs.
-        mref_path = cache / f"mitsuba-{tag}-{args.ref_spp}.npy"
+        mref_path = cache / f"mitsuba-{mi.__version__}-{tag}-{args.ref_spp}.npy"
         if mref_path.exists():
             mref = np.load(mref_path)
         else:
