@@ -1,12 +1,16 @@
 // Exports a scene as our renderer sees it, for bench/vs_mitsuba.py: the geometry after our loader
 // (world-space triangles, split by material, as binary PLY; spheres as spheres), the materials,
-// the lights and the comparison framing's camera (the course's view at 480x360, keep_fov), as one
-// JSON file the script turns into a Mitsuba 3 scene dictionary. Kinds Mitsuba's comparison does
-// not need (point, spot, directional, ambient lights) are refused with a message, never skipped.
+// the lights and the comparison framing's camera, as one JSON file the script turns into a Mitsuba 3
+// scene dictionary. The camera is the course's framing at the size: its crop of the 800x600 view,
+// as `pathtracer -r W H` renders (or with --whole-view the whole view scaled, as --keep-fov), with
+// a thin lens of --aperture (radius) and --focal-distance. Kinds Mitsuba's comparison does not need
+// (point, spot, directional, ambient lights) are refused with a message, never skipped.
 //
-//   ./build/bench_export_mitsuba scene.dae OUT_DIR [--width 480 --height 360]
+//   ./build/bench_export_mitsuba scene.dae OUT_DIR [--width 480 --height 360] [--whole-view]
+//                                [--aperture R --focal-distance D]
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <stdexcept>
@@ -16,7 +20,7 @@
 
 #include "args.h"
 #include "camera.h"
-#include "collada.h"
+#include "scene_file.h"
 
 namespace {
 
@@ -51,26 +55,38 @@ json material_json(const pt::Material& m) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::Args args(argc, argv, "bench_export_mitsuba scene.dae OUT_DIR [--width W=480 --height H=360]");
+  bench::Args args(argc, argv, "bench_export_mitsuba scene.dae OUT_DIR [--width W=480 --height H=360] [--whole-view] "
+                               "[--aperture R=0 --focal-distance D=4.7]");
   const int width = args.integer("--width", 480, 1, 16384), height = args.integer("--height", 360, 1, 16384);
+  const bool whole_view = args.flag("--whole-view");
+  auto real = [&](const char* name, double def) {
+    const std::string v = args.value(name, "");
+    if (v.empty()) return def;
+    char* end = nullptr;
+    const double x = std::strtod(v.c_str(), &end);
+    if (*end || !std::isfinite(x) || x < 0) args.fail(std::string(name) + " must be a number of at least 0");
+    return x;
+  };
+  const double aperture = real("--aperture", 0), focal_distance = real("--focal-distance", pt::kCourseFocalDistance);
   const std::vector<std::string> files = args.positional();
   args.finish();
   if (files.size() != 2) args.fail("needs a scene file and an output folder");
   try {
     const std::string& scene_path = files[0];
     const std::string& out_dir = files[1];
-    pt::SceneDesc desc = pt::load_collada(scene_path);
+    pt::SceneDesc desc = pt::load_scene(scene_path);
 
     json scene;
     pt::CameraParams cp;
     cp.width = width;
     cp.height = height;
-    cp.keep_fov = true;
+    cp.keep_fov = whole_view;
     pt::Camera cam = pt::make_camera(desc, cp);
     scene["camera"] = {{"origin", vec(cam.position)}, {"target", vec(cam.position - cam.back)}, {"up", vec(cam.up)},
                        {"fov_x_deg", 2 * std::atan(cam.tan_half_w) * 180 / M_PI},
                        {"fov_y_deg", 2 * std::atan(cam.tan_half_h) * 180 / M_PI},
-                       {"width", width}, {"height", height}};
+                       {"width", width}, {"height", height},
+                       {"lens_radius", aperture}, {"focal_distance", focal_distance}};
     scene["materials"] = json::array();
     for (const pt::Material& m : desc.materials) scene["materials"].push_back(material_json(m));
 
