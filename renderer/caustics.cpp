@@ -131,6 +131,95 @@ std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std
   return out;
 }
 
+namespace {
+
+// The plane of an emitting face (an area light's rectangle or an emissive triangle) and its box.
+struct EmitterFace {
+  Vec3 n;
+  float d;
+  Bounds3 box;
+  int owner;  // a mesh index, or meshes.size() + the area light's index
+};
+
+bool boxes_touch(const Bounds3& a, const Bounds3& b, float pad) {
+  return a.lo.x <= b.hi.x + pad && b.lo.x <= a.hi.x + pad && a.lo.y <= b.hi.y + pad && b.lo.y <= a.hi.y + pad &&
+         a.lo.z <= b.hi.z + pad && b.lo.z <= a.hi.z + pad;
+}
+
+}  // namespace
+
+bool emitters_share_a_plane(const SceneDesc& desc, const std::vector<Material>& materials) {
+  constexpr size_t kMaxFaces = 32;  // past this many emitting faces, assume they may
+  std::vector<EmitterFace> faces;
+  auto face = [&](Vec3 a, Vec3 b, Vec3 c, int owner) {
+    Vec3 n = cross(b - a, c - a);
+    float len = length(n);
+    if (!(len > 0)) return;
+    EmitterFace f{n / len, 0, {}, owner};
+    f.d = dot(f.n, a);
+    for (Vec3 v : {a, b, c}) f.box.expand(v);
+    faces.push_back(f);
+  };
+  const int meshes = int(desc.meshes.size());
+  // A rectangle as the triangles (a, b, c) and (a, c, d).
+  auto rect = [&](const LightDesc& l, Vec3 out[4]) {
+    Vec3 hx = l.dim_x * 0.5f, hy = l.dim_y * 0.5f;
+    out[0] = l.position - hx - hy, out[1] = l.position + hx - hy, out[2] = l.position + hx + hy,
+    out[3] = l.position - hx + hy;
+  };
+  for (size_t i = 0; i < desc.lights.size(); ++i) {
+    if (desc.lights[i].type != LightType::area) continue;
+    Vec3 q[4];
+    rect(desc.lights[i], q);
+    face(q[0], q[1], q[2], meshes + int(i));
+    if (!faces.empty() && faces.back().owner == meshes + int(i)) faces.back().box.expand(q[3]);
+  }
+  for (size_t m = 0; m < desc.meshes.size(); ++m) {
+    const MeshDesc& mesh = desc.meshes[m];
+    for (size_t t = 0; t < mesh.tri_material.size() && faces.size() <= kMaxFaces; ++t) {
+      if (!is_emissive(materials[size_t(mesh.tri_material[t])])) continue;
+      const uint32_t* v = &mesh.indices[3 * t];
+      face(mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], int(m));
+    }
+  }
+  if (faces.size() > kMaxFaces) return true;
+  // Within rounding of a spawned ray's offset (Waechter and Binder scale theirs with the
+  // coordinates), generously.
+  auto in_plane = [](const EmitterFace& f, Vec3 p) {
+    return std::fabs(dot(f.n, p) - f.d) <= 1e-4f * (1 + max_component(abs(p)));
+  };
+  // Whether triangle (a, b, c) of `owner` lies in the plane of another emitter and overlaps its box.
+  auto overlaps = [&](Vec3 a, Vec3 b, Vec3 c, int owner, bool emissive) {
+    Bounds3 box;
+    for (Vec3 v : {a, b, c}) box.expand(v);
+    for (const EmitterFace& f : faces) {
+      if (f.owner == owner && (emissive || owner >= meshes)) continue;  // an emitter's own faces
+      if (!boxes_touch(box, f.box, 1e-4f * (1 + max_component(abs(f.box.hi)))) || !in_plane(f, a) || !in_plane(f, b) ||
+          !in_plane(f, c))
+        continue;
+      return true;
+    }
+    return false;
+  };
+  for (size_t m = 0; m < desc.meshes.size(); ++m) {
+    const MeshDesc& mesh = desc.meshes[m];
+    for (size_t t = 0; t < mesh.tri_material.size(); ++t) {
+      const uint32_t* v = &mesh.indices[3 * t];
+      if (overlaps(mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], int(m),
+                   is_emissive(materials[size_t(mesh.tri_material[t])])))
+        return true;
+    }
+  }
+  for (size_t i = 0; i < desc.lights.size(); ++i) {
+    if (desc.lights[i].type != LightType::area) continue;
+    Vec3 q[4];
+    rect(desc.lights[i], q);
+    if (overlaps(q[0], q[1], q[2], meshes + int(i), true) || overlaps(q[0], q[2], q[3], meshes + int(i), true))
+      return true;
+  }
+  return false;
+}
+
 bool caustic_tracing_applies(const RenderScene& scene, const RenderParams& params) {
   const Camera& cam = scene.camera;
   const bool camera_ok = cam.lens_radius <= 0 || (cam.focal_distance > 0 && std::isfinite(cam.focal_distance));
@@ -145,6 +234,8 @@ struct LightPath {
   Sampler rng{SamplerKind::independent, 0, 0, 0};  // set by start_light_path
   Ray ray;
   Vec3 beta, throughput{1.0f};
+  Vec3 origin;     // the point on the light it left
+  int light = -1;  // that light (RenderScene::lights)
   int delta_bounces = 0, diffuse_vertices = 0, vertex = 1;  // the next vertex, as the path tracer counts
   uint32_t id = 0;                                          // its place among the call's paths
 };
@@ -179,6 +270,8 @@ bool start_light_path(const RenderScene& scene, const RenderParams& params, uint
   float pdf_dir = float(holding) / total;
   lp.beta = light.color * (cos_l * light.area / (p_light * pdf_dir));
   if (!is_finite(lp.beta)) return false;
+  lp.origin = x0;
+  lp.light = scene.caustic_lights[li];
   lp.ray.o = offset_ray_origin(x0, n);
   lp.ray.d = wi;
   lp.ray.tmin = 0;
@@ -189,12 +282,28 @@ bool start_light_path(const RenderScene& scene, const RenderParams& params, uint
   return true;
 }
 
+// Whether the path tracer, arriving at the light path's first vertex `hit` from the other way,
+// would see the light at the point the path left: the same closest-hit query, reversed. The
+// forward ray leaves the light's plane, so it cannot see a surface that overlaps the light in that
+// plane (emitters_share_a_plane), and light paths would count both emitters where the path tracer,
+// whose share they replace, sees one.
+bool light_seen_from(const RenderScene& scene, const SurfaceHit& hit, const LightPath& lp, uint64_t& rays) {
+  Vec3 to_light = lp.origin - hit.p;
+  float dist = length(to_light);
+  if (!(dist > 0)) return false;
+  Ray back;
+  spawn_ray(hit, to_light / dist, back);
+  SurfaceHit seen;
+  ++rays;
+  return scene.accel->intersect(back, seen) && seen.light == lp.light;
+}
+
 // What a light path does with its ray's hit: a connection to the camera from a non-delta vertex
 // (its shadow ray and splat go to `connect`), then the BSDF bounce and roulette. False when the
 // path ends; otherwise lp.ray is the next ray.
 template <class Connect>
 bool light_path_step(const RenderScene& scene, const RenderParams& params, const CausticFilm& film, LightPath& lp,
-                     bool found, const SurfaceHit& hit, Connect&& connect) {
+                     bool found, const SurfaceHit& hit, uint64_t& rays, Connect&& connect) {
   const int vertex = lp.vertex++;
   if (!found) return false;
   const Material& m = material_at(scene, scene.materials[hit.material], hit);  // used within this call
@@ -203,6 +312,7 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
   // Ours are L S+ D+ E: a first non-delta vertex ends a path with no delta bounce, and a delta
   // one after the diffuse part ends it too (the path tracer renders both).
   if (delta ? lp.diffuse_vertices > 0 : lp.delta_bounces == 0) return false;
+  if (vertex == 1 && scene.emitters_share_a_plane && !light_seen_from(scene, hit, lp, rays)) return false;
   Sampler& rng = lp.rng;
   if (!delta) {
     Vec2 u_lens = scene.camera.lens_radius > 0 ? rng.next_2d() : Vec2{0.5f, 0.5f};
@@ -289,7 +399,7 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
         shadows.push_back(shadow);
         pending.push_back({lp.id, splat});
       };
-      if (light_path_step(scene, params, film, lp, found[i] != 0, hits[i], connect)) {
+      if (light_path_step(scene, params, film, lp, found[i] != 0, hits[i], rays, connect)) {
         if (live != i) paths[live] = std::move(lp);
         ++live;
       }

@@ -36,6 +36,12 @@ struct CausticTarget {
 constexpr size_t kMaxCausticTargets = 64;
 std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std::vector<Material>& materials);
 
+// Whether an emitter (area light or emissive triangle) has another surface in its plane over it, as
+// the course's CBdragon has an area light and an emissive quad in one plane: where two surfaces
+// overlap, a ray sees one of them, and light paths must check which (caustics.cpp,
+// light_seen_from) or they would count both. Conservative: faces that only touch count too.
+bool emitters_share_a_plane(const SceneDesc& desc, const std::vector<Material>& materials);
+
 // Whether a view of the scene with these options renders caustics by light tracing: it needs a
 // delta material, an area or mesh light, more than one sample per pixel (one sample is the pixel
 // centre, which splats cannot match), light sampling (not -H), and a pinhole or a thin lens

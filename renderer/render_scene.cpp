@@ -196,6 +196,7 @@ SceneBase make_scene_base(const SceneDesc& desc) {
   base.camera = desc.camera;
   base.bounds = desc.geometry_bounds();
   base.caustic_targets = find_caustic_targets(desc, base.materials);
+  base.emitters_share_a_plane = emitters_share_a_plane(desc, base.materials);
   // Each object's box, padded as Accel pads the scene's (relative to the largest coordinate).
   for (const MeshDesc& m : desc.meshes) {
     Bounds3 b;
@@ -277,6 +278,7 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
       rs->infinite_lights.push_back(int(i));
   rs->camera = make_camera(base.camera, base.bounds, camera_params(params));
   rs->caustic_targets = std::move(base.caustic_targets);
+  rs->emitters_share_a_plane = base.emitters_share_a_plane;
   rs->object_bounds = std::move(base.object_bounds);
   std::vector<float> power;
   for (size_t i = 0; i < rs->lights.size(); ++i) {

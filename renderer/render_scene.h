@@ -52,6 +52,7 @@ struct SceneBase {
   CameraDesc camera;                // what make_camera reads of the file
   Bounds3 bounds;
   std::vector<CausticTarget> caustic_targets;  // bounds of the delta-material geometry
+  bool emitters_share_a_plane = false;         // caustics.h: light paths check what a ray sees
   std::vector<Bounds3> object_bounds;  // each mesh, sphere and light panel, padded as Accel pads its bounds
   std::string source;
 
@@ -83,6 +84,7 @@ struct RenderScene {
   std::vector<Bounds3> object_bounds;  // from SceneBase: what the background mask projects
   std::vector<int> caustic_lights;
   Distribution1D caustic_light_distribution;
+  bool emitters_share_a_plane = false;  // from SceneBase (caustics.h)
 };
 
 // A textured material's albedo at a hit: its albedo times its texture at the hit's uv and the

@@ -97,17 +97,31 @@ SceneDesc mesh_light_metal_cornell() {
   return desc;
 }
 
+// The Cornell box with an emissive quad in its area light's place: two emitters in one plane (as
+// in the course's CBdragon), of which the path tracer sees one along each ray.
+SceneDesc coplanar_emitters_cornell() {
+  SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
+  SceneDesc both = desc;
+  test::area_lights_as_meshes(both);  // adds the quads and their material
+  both.lights = desc.lights;          // and keeps the area lights
+  return both;
+}
+
+enum class SplitScene { cornell, mesh_light_metal, coplanar_emitters };
+
 struct SplitCase {
   const char* name;
   float lens_radius;  // 0: pinhole; else splats through the lens map to pixels as its rays do
-  bool mesh_light_metal;
+  SplitScene scene;
 };
 
 class CausticSplit : public ::testing::TestWithParam<SplitCase> {
  protected:
   void SetUp() override {
-    SceneDesc desc = GetParam().mesh_light_metal ? mesh_light_metal_cornell()
-                                                 : load_collada(test::own_scene("cornell.dae"));  // mirror, glass, area light
+    const SplitScene which = GetParam().scene;
+    SceneDesc desc = which == SplitScene::mesh_light_metal    ? mesh_light_metal_cornell()
+                     : which == SplitScene::coplanar_emitters ? coplanar_emitters_cornell()
+                                                              : load_collada(test::own_scene("cornell.dae"));  // mirror, glass, area light
     RenderParams p = cornell_params();
     p.spp = 256;
     p.lens_radius = GetParam().lens_radius;
@@ -120,8 +134,10 @@ class CausticSplit : public ::testing::TestWithParam<SplitCase> {
   std::unique_ptr<SeedStats> alone;  // path tracing alone
 };
 INSTANTIATE_TEST_SUITE_P(Cases, CausticSplit,
-                         ::testing::Values(SplitCase{"Pinhole", 0, false}, SplitCase{"ThinLens", 0.12f, false},
-                                           SplitCase{"MeshLightRoughMetal", 0, true}),
+                         ::testing::Values(SplitCase{"Pinhole", 0, SplitScene::cornell},
+                                           SplitCase{"ThinLens", 0.12f, SplitScene::cornell},
+                                           SplitCase{"MeshLightRoughMetal", 0, SplitScene::mesh_light_metal},
+                                           SplitCase{"CoplanarEmitters", 0, SplitScene::coplanar_emitters}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 TEST_P(CausticSplit, SplitWithThePathTracerConvergesToThePathTracersImageAndRemovesMostOfItsNoise) {
@@ -216,6 +232,35 @@ TEST(Caustics, PooledLightPathsSplatAsOnePathAtATime) {
     ASSERT_EQ(std::memcmp(&pooled[k].value, &single[k].value, sizeof(Vec3)), 0) << k;
   }
   EXPECT_EQ(pooled_rays, single_rays);
+}
+
+// Light paths check what a ray sees at their light only where an emitter shares its plane with
+// another surface; other scenes do not pay that ray.
+TEST(Caustics, OnlyEmittersThatShareAPlaneCostTheCheck) {
+  SceneDesc cornell = load_collada(test::own_scene("cornell.dae"));
+  EXPECT_FALSE(emitters_share_a_plane(cornell, cornell.materials));
+  SceneDesc both = coplanar_emitters_cornell();
+  EXPECT_TRUE(emitters_share_a_plane(both, both.materials));
+  SceneDesc meshed = cornell;
+  test::area_lights_as_meshes(meshed);  // one quad: its two triangles are one emitter
+  EXPECT_FALSE(emitters_share_a_plane(meshed, meshed.materials));
+  // A quad of the ceiling's material laid over the light, in its plane.
+  SceneDesc covered = meshed;
+  MeshDesc cover = covered.meshes.back();
+  cover.tri_material.assign(cover.tri_material.size(), 0);
+  ASSERT_FALSE(is_emissive(covered.materials[0]));
+  covered.meshes.push_back(cover);
+  EXPECT_TRUE(emitters_share_a_plane(covered, covered.materials));
+  // Lifted off the plane by more than a spawned ray's offset, it no longer does.
+  Vec3 normal = normalize(cross(cover.positions[1] - cover.positions[0], cover.positions[2] - cover.positions[0]));
+  for (Vec3& v : covered.meshes.back().positions) v = v + normal * 0.01f;
+  EXPECT_FALSE(emitters_share_a_plane(covered, covered.materials));
+  for (const char* f : {"CBdragon.dae", "CBspheres.dae", "CBbunny.dae"}) {
+    std::string path = test::shared_scene(f);
+    if (path.empty()) continue;
+    SceneDesc desc = load_collada(path);
+    EXPECT_EQ(emitters_share_a_plane(desc, desc.materials), std::string(f) == "CBdragon.dae") << f;
+  }
 }
 
 TEST(Caustics, AppliesOnlyWhereItCan) {
