@@ -29,13 +29,26 @@ using pt::Vec3;
 
 json vec(Vec3 v) { return json::array({v.x, v.y, v.z}); }
 
-void write_ply(const std::string& path, const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices) {
+// A binary PLY of the triangles `indices` over `positions`, with the file's shading normals where
+// it has them: Mitsuba would otherwise make its own from the faces, and the renderers would shade
+// curved meshes differently.
+void write_ply(const std::string& path, const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+               const std::vector<uint32_t>& indices) {
   std::ofstream out(path, std::ios::binary);
   if (!out) throw std::runtime_error(path + ": cannot write");
+  const bool with_normals = normals.size() == positions.size();
   out << "ply\nformat binary_little_endian 1.0\nelement vertex " << positions.size()
-      << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << indices.size() / 3
-      << "\nproperty list uchar int vertex_indices\nend_header\n";
-  out.write(reinterpret_cast<const char*>(positions.data()), std::streamsize(positions.size() * sizeof(Vec3)));
+      << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << (with_normals ? "property float nx\nproperty float ny\nproperty float nz\n" : "") << "element face "
+      << indices.size() / 3 << "\nproperty list uchar int vertex_indices\nend_header\n";
+  if (with_normals) {
+    for (size_t i = 0; i < positions.size(); ++i) {
+      const Vec3 pair[2] = {positions[i], normals[i]};
+      out.write(reinterpret_cast<const char*>(pair), sizeof pair);
+    }
+  } else {
+    out.write(reinterpret_cast<const char*>(positions.data()), std::streamsize(positions.size() * sizeof(Vec3)));
+  }
   for (size_t t = 0; t < indices.size(); t += 3) {
     unsigned char three = 3;
     int32_t idx[3] = {int32_t(indices[t]), int32_t(indices[t + 1]), int32_t(indices[t + 2])};
@@ -99,7 +112,7 @@ int main(int argc, char** argv) {
         for (int c = 0; c < 3; ++c) by_material[mesh.tri_material[t]].push_back(mesh.indices[3 * t + c]);
       for (auto& [material, indices] : by_material) {
         std::string file = "mesh" + std::to_string(mi) + "_m" + std::to_string(material) + ".ply";
-        write_ply(out_dir + "/" + file, mesh.positions, indices);
+        write_ply(out_dir + "/" + file, mesh.positions, mesh.normals, indices);
         scene["meshes"].push_back({{"file", file}, {"material", material}, {"smooth", !mesh.normals.empty()}});
       }
     }

@@ -17,10 +17,11 @@ the course's CBspheres, CBbunny and CBdragon (../shared) and our dof.dae through
 Mitsuba comes from PyPI into build/mitsuba-venv (mitsuba 3.9.1; its Dr.Jit emits LLVM IR that needs
 LLVM 16 or newer: Debian 12's libllvm19 or libllvm16, found and handed to Dr.Jit through
 DRJIT_LIBLLVM_PATH). `build/bench_export_mitsuba` writes each scene as our loader sees it (world
-triangles as PLY, spheres, materials, area lights, the comparison framing's camera: the course's
-view at 480x360, keep_fov). Both renderers: 2 threads, one light sample, no adaptive sampling, a
+triangles and their shading normals as PLY, spheres, materials, area lights, and the camera of the
+framing compared: the course's crop, or its whole view scaled to 480x360). Both renderers: 2 threads, one light sample, no adaptive sampling, a
 box pixel filter; Mitsuba's max_depth counts the emitter hit, so our -m M is its max_depth M + 1.
-Each renderer's error is measured against its own high-spp reference (cached in build/bench-cache),
+Each renderer's error is measured against its own high-spp reference (cached in build/bench-cache,
+keyed on the content of the pathtracer binary, or of the exported scene and Mitsuba's release),
 and the two references are compared with each other to check that the conversion is faithful.
 Timings exclude start-up: Mitsuba's kernel compilation (one warm-up render) and our scene load.
 --ours adds flags to our timed runs only (the reference keeps the defaults): flags that change how
@@ -29,9 +30,11 @@ Mitsuba's `path` does). --profile also prints each renderer's share of time in r
 and the intersection callbacks it calls), measured with perf (query_share.py).
 """
 import argparse
+import hashlib
 import json
 import os
 import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -39,6 +42,7 @@ import time
 from pathlib import Path
 
 import query_share
+from host import host_description
 from progress import clear, progress
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -143,21 +147,12 @@ def mitsuba_scene(mi, folder, depth, spp, sampler="independent"):
     return mi.load_dict(scene)
 
 
-def host_description():
-    """CPU model, CPUs this process may use, widest vector ISA: as the C++ benchmarks print it."""
-    model, flags = "unknown CPU", set()
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                key, _, value = line.partition(":")
-                if key.strip() == "model name" and model == "unknown CPU":
-                    model = value.strip()
-                elif key.strip() == "flags" and not flags:
-                    flags = set(value.split())
-    except OSError:
-        pass
-    isa = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE2"
-    return f"{model}, {len(os.sched_getaffinity(0))} CPUs, {isa}"
+def digest(paths):
+    """A short content hash: the cached references are keyed on what made them."""
+    h = hashlib.sha1()
+    for p in sorted(paths):
+        h.update(Path(p).read_bytes())
+    return h.hexdigest()[:10]
 
 
 def ours_command(args, scene_path, depth, spp, out, seed, extra=(), build=BUILD):
@@ -228,12 +223,14 @@ def main():
           f"against its own {args.ref_spp}-spp reference (another seed); Mitsuba {mi.__version__} llvm_ad_rgb "
           f"({llvm}), samplers {', '.join(samplers)}" + (f"; ours with {args.ours}" if args.ours else ""))
     rows = []
+    ours_binary = digest([BUILD / "pathtracer"])
     for name in names:
         path, depth, lens, focus = SCENES[name]
         depth = args.depth or depth
         tag = f"{name}-{args.framing}-m{depth}"
         folder = cache / f"mitsuba-{name}-{args.framing}"
-        folder.mkdir(exist_ok=True)
+        shutil.rmtree(folder, ignore_errors=True)  # no file of an older export stays
+        folder.mkdir()
         subprocess.run([str(BUILD / "bench_export_mitsuba"), str(path), str(folder), "--aperture", str(lens),
                         "--focal-distance", str(focus), *(["--whole-view"] if args.framing == "view" else [])],
                        check=True, stdout=subprocess.DEVNULL)
@@ -241,7 +238,8 @@ def main():
         steps = len(samplers) * args.runs + args.runs
         # Mitsuba: its reference (cached), then per sampler one warm-up render (kernel compilation)
         # and the timed runs.
-        mref_path = cache / f"mitsuba-{mi.__version__}-{tag}-{args.ref_spp}.npy"
+        exported = digest(p for p in folder.iterdir() if p.is_file())
+        mref_path = cache / f"mitsuba-{mi.__version__}-{tag}-{exported}-{args.ref_spp}.npy"
         if mref_path.exists():
             mref = np.load(mref_path)
         else:
@@ -264,7 +262,7 @@ def main():
             mitsuba[sampler] = (statistics.median(mt), statistics.median(me))
         best = max(mitsuba, key=lambda s: 1 / (mitsuba[s][0] * mitsuba[s][1]))
         # Ours: its reference (cached EXR), the timed runs.
-        oref_path = cache / f"ours-{tag}-{args.ref_spp}-{args.sampler or 'default'}.exr"
+        oref_path = cache / f"ours-{tag}-{ours_binary}-{args.ref_spp}-{args.sampler or 'default'}.exr"
         if not oref_path.exists():
             progress(f"{name}: our reference", done / steps, started)
             run_ours(args, path, depth, args.ref_spp, oref_path, 7919)
