@@ -15,7 +15,6 @@ before it, as the bar showed it then. `work` is the samples predicted in all at 
 """
 import argparse
 import csv
-import os
 import statistics
 import subprocess
 import sys
@@ -23,6 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from host import host_description
 from progress import clear, progress
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,23 +38,6 @@ SCENES = {
 }
 MARKS = (0.10, 0.25, 0.50, 0.75)
 GOAL = 0.25  # |relative error| from the 25% mark on
-
-
-def host_description():
-    """CPU model, CPUs this process may use, widest vector ISA: as the C++ benchmarks print it."""
-    model, flags = "unknown CPU", set()
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                key, _, value = line.partition(":")
-                if key.strip() == "model name" and model == "unknown CPU":
-                    model = value.strip()
-                elif key.strip() == "flags" and not flags:
-                    flags = set(value.split())
-    except OSError:
-        pass
-    isa = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE2"
-    return f"{model}, {len(os.sched_getaffinity(0))} CPUs, {isa}"
 
 
 def read_log(path):

@@ -2,9 +2,8 @@
 // The dialect is described in scenes/README.md; deviations from the course parser in docs/cs184-compat.md.
 #include "collada.h"
 
-#include <fstream>
-
 #include "collada_reader.h"
+#include "scene_file.h"
 
 namespace pt {
 namespace collada_detail {
@@ -342,17 +341,7 @@ SceneDesc parse_collada(const std::string& text, const std::string& name, const 
 }
 
 SceneDesc load_collada(const std::string& path, const LoadLimits& limits) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw SceneError(path + ": cannot open file");
-  std::streamoff size = in.tellg();
-  if (size < 0) throw SceneError(path + ": cannot read file");
-  if (size_t(size) > limits.max_file_bytes)
-    throw SceneError(path + ": file is " + std::to_string(size) + " bytes, over the limit of " +
-                     std::to_string(limits.max_file_bytes));
-  std::string text(size_t(size), '\0');
-  in.seekg(0);
-  if (!in.read(text.data(), size)) throw SceneError(path + ": cannot read file");
-  return parse_collada(text, path, limits);
+  return parse_collada(read_scene_bytes(path, limits), path, limits);
 }
 
 }  // namespace pt

@@ -1,45 +1,21 @@
 // libFuzzer target: scene text -> parse_collada -> make_render_scene (tiny render parameters) and
-// one autofocus ray; never renders. Built only in build-fuzz by scripts/fuzz.sh (clang,
-// -fsanitize=fuzzer,address,undefined). A loader error must be a SceneError; anything else
-// escaping, a sanitizer report, a timeout or an out-of-memory is a finding.
+// one autofocus ray; never renders (fuzz_scene.h). Built only in build-fuzz by scripts/fuzz.sh
+// (clang, -fsanitize=fuzzer,address,undefined). A loader error must be a SceneError; anything
+// else escaping, a sanitizer report, a timeout or an out-of-memory is a finding.
 #include <cstddef>
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 
 #include "collada.h"
-#include "session.h"
+#include "fuzz_scene.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  // Smaller than the defaults so each input stays fast; the limit checks themselves are exercised.
-  static const pt::LoadLimits limits = [] {
-    pt::LoadLimits l;
-    l.max_file_bytes = size_t(4) << 20;
-    l.max_triangles = 200'000;
-    l.max_nodes = 20'000;
-    l.max_markup = 200'000;
-    l.max_values = 2'000'000;
-    return l;
-  }();
   std::string text(reinterpret_cast<const char*>(data), size);
   pt::SceneDesc desc;
   try {
-    desc = pt::parse_collada(text, "fuzz.dae", limits);
+    desc = pt::parse_collada(text, "fuzz.dae", fuzz::scene_limits());
   } catch (const pt::SceneError&) {
     return 0;  // a located load error: the expected outcome for most inputs
   }
-  pt::RenderParams params;
-  params.width = 8;
-  params.height = 6;
-  params.spp = 1;
-  params.threads = 1;
-  params.file_camera = size % 2 == 1;  // both camera placements
-  std::unique_ptr<pt::RenderScene> scene;
-  try {
-    scene = pt::make_render_scene(desc, params);
-  } catch (const std::runtime_error&) {
-    return 0;  // a build failure (Embree) is reported, not a crash
-  }
-  pt::autofocus_distance(*scene, 0.5f, 0.5f);
-  return 0;
+  return fuzz::build_and_probe(desc, size);
 }

@@ -106,6 +106,18 @@ def failed_tries(workers, job_id):
     return tries
 
 
+def assert_single_process_image(srv, job_id, servers):
+    """The job's image is the one a single process renders of JOB: the samples are the same, only
+    the merge order differs (so within float rounding, not bit for bit)."""
+    single = servers("single", threads=2)
+    ref_id = single.api.submit(JOB)["id"]
+    assert single.api.wait(ref_id, FINAL, timeout=180)["state"] == "done"
+    _, _, dist, _ = image(srv.api, job_id)
+    _, _, ref, _ = image(single.api, ref_id)
+    worst = max(abs(a - b) / (abs(b) + 1e-3) for c in "RGB" for a, b in zip(dist[c], ref[c]))
+    assert worst < 1e-3, f"the image differs from a single process's by up to {worst:.2e} (relative)"
+
+
 def test_a_pass_that_keeps_failing_is_dead_lettered_and_fails_its_job(cluster):
     srv, workers, redis = cluster(workers=0)
     job_id = srv.api.submit(SMALL)["id"]
@@ -179,14 +191,7 @@ def test_a_redis_restart_mid_job_loses_nothing(cluster, servers):
     assert "issuing its" in srv.log_text(), "the server did not put the run back"
     assert any(re.search(r"Redis at \S+ is back after", w.text()) for w in workers), "no worker reconnected"
     assert all(w.proc.poll() is None for w in workers), "a worker died"
-    # The same image as one process renders (the samples are the same; merge order differs).
-    single = servers("single", threads=2)
-    ref_id = single.api.submit(JOB)["id"]
-    assert single.api.wait(ref_id, FINAL, timeout=180)["state"] == "done"
-    _, _, dist, _ = image(srv.api, job_id)
-    _, _, ref, _ = image(single.api, ref_id)
-    worst = max(abs(a - b) / (abs(b) + 1e-3) for c in "RGB" for a, b in zip(dist[c], ref[c]))
-    assert worst < 1e-3, f"images differ by up to {worst:.2e} (relative)"
+    assert_single_process_image(srv, job_id, servers)
     # Later jobs render on the new Redis as usual.
     later = srv.api.submit(dict(SMALL, seed=2))["id"]
     assert srv.api.wait(later, FINAL, timeout=60)["state"] == "done"
@@ -210,13 +215,7 @@ def test_a_server_killed_mid_job_resumes_its_merged_film(cluster, servers):
     assert done["state"] == "done", done
     assert "resuming from its checkpoint" in srv.log_text()
     assert done["samples"] == JOB["width"] * JOB["height"] * JOB["spp"], "every sample merged exactly once"
-    single = servers("single", threads=2)
-    ref_id = single.api.submit(JOB)["id"]
-    assert single.api.wait(ref_id, FINAL, timeout=180)["state"] == "done"
-    _, _, dist, _ = image(srv.api, job_id)
-    _, _, ref, _ = image(single.api, ref_id)
-    worst = max(abs(a - b) / (abs(b) + 1e-3) for c in "RGB" for a, b in zip(dist[c], ref[c]))
-    assert worst < 1e-3, f"the resumed image differs by up to {worst:.2e} (relative)"
+    assert_single_process_image(srv, job_id, servers)
 
 
 def test_redis_gone_for_good_fails_the_job_after_redis_timeout(cluster):
