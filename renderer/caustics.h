@@ -9,6 +9,8 @@
 //   bounces after one or more non-delta vertices, the first camera vertex among them (E D+ S+ L);
 // - the light tracer produces exactly those paths: it leaves an area or mesh light, follows one or
 //   more delta bounces, and connects every non-delta vertex after them to the camera (L S+ D+ E).
+//   Where an emitter shares its plane with another surface, it keeps only the light points the
+//   path tracer would see from its first vertex (emitters_share_a_plane).
 // Light paths are aimed at bounding spheres of the delta geometry (a directional pdf over the cones
 // they subtend), since every other direction starts a path the path tracer keeps.
 #pragma once
