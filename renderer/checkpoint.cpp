@@ -30,13 +30,37 @@ uint64_t fnv1a(const std::string& bytes) {
   throw std::runtime_error(path + ": cannot " + doing + " the checkpoint (" + std::strerror(errno) + ")");
 }
 
+// "HASH (N bytes)" of a file's contents, or "unreadable".
+std::string file_digest(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "unreadable";
+  std::string bytes(std::istreambuf_iterator<char>(in), {});
+  char hash[20];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(bytes)));
+  return std::string(hash) + " (" + std::to_string(bytes.size()) + " bytes)";
+}
+
 }  // namespace
 
-std::string render_fingerprint(const std::string& scene_bytes, const RenderParams& p) {
+std::string render_fingerprint(const std::string& scene_bytes, const RenderParams& p,
+                               const std::vector<std::string>& input_files) {
   std::ostringstream f;
   char hash[20];
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(scene_bytes)));
   f << "scene " << hash << " (" << scene_bytes.size() << " bytes)";
+  // Each file by name, so that a refusal shows which changed; past a few dozen, one digest of all
+  // (the fingerprint stays far below kMaxFingerprint).
+  constexpr size_t kFilesNamed = 32;
+  if (input_files.size() <= kFilesNamed) {
+    for (const std::string& file : input_files) f << ", file '" << file << "' " << file_digest(file);
+  } else {
+    std::string all;
+    for (const std::string& file : input_files) all += file + '\n' + file_digest(file) + '\n';
+    std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(all)));
+    f << ", " << input_files.size() << " files " << hash;
+  }
+  if (!p.env_map.empty()) f << ", environment " << file_digest(p.env_map);
+  if (!p.camera_file.empty()) f << ", camera file " << file_digest(p.camera_file);
   const RunLimits none;
   for (const RenderOption& o : render_options()) {
     const std::string name = o.name;

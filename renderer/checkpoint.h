@@ -7,14 +7,18 @@
 
 #include <chrono>
 #include <string>
+#include <vector>
 
 #include "session.h"
 
 namespace pt {
 
-// What a checkpoint must match to be resumed: the scene file's bytes and every option that changes
-// the image (not the thread count, tile size or the limits, which only decide when it stops).
-std::string render_fingerprint(const std::string& scene_bytes, const RenderParams& params);
+// What a checkpoint must match to be resumed: the scene file's bytes, the contents of the other
+// files the image depends on (`input_files`: SceneDesc::input_files; and the environment map and
+// camera file the options name), and every option that changes the image (not the thread count,
+// tile size or the limits, which only decide when it stops).
+std::string render_fingerprint(const std::string& scene_bytes, const RenderParams& params,
+                               const std::vector<std::string>& input_files = {});
 
 // Writes the checkpoint to `path` (a temporary file, flushed to disk, then renamed over it).
 void save_checkpoint(const std::string& path, const std::string& fingerprint, const RenderSession& session,

@@ -87,10 +87,11 @@ struct Images {
   std::vector<TextureDesc> images;
   std::vector<bool> ok;
 };
-// tinygltf's model of the checked file, external files read only inside ctx.base_dir, the
-// images materials read decoded (Images) within the texture limits.
+// tinygltf's model of the checked file, external files read only inside ctx.base_dir (their
+// resolved paths added to `files_read`), the images materials read decoded (Images) within the
+// texture limits.
 tinygltf::Model run_tinygltf(const Context& ctx, const std::string& bytes, const Parts& parts, const Checked& checked,
-                             Images& images);
+                             Images& images, std::vector<std::string>& files_read);
 
 // The scene's nodes, meshes, cameras and lights (gltf_scene.cpp), with materials made on demand.
 SceneDesc build_scene(const Context& ctx, const tinygltf::Model& model, Images& images);

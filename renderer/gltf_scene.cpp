@@ -362,8 +362,10 @@ SceneDesc parse_gltf(const std::string& bytes, const std::string& name, bool bin
   Parts parts = split_file(ctx, bytes);
   Checked checked = check_json(ctx, parts);
   Images images;
-  tinygltf::Model model = run_tinygltf(ctx, bytes, parts, checked, images);
+  std::vector<std::string> files_read;
+  tinygltf::Model model = run_tinygltf(ctx, bytes, parts, checked, images, files_read);
   SceneDesc desc = build_scene(ctx, model, images);
+  desc.input_files = std::move(files_read);
   desc.warnings = ctx.take_warnings();
   return desc;
 }

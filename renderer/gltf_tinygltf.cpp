@@ -19,6 +19,7 @@ namespace {
 struct FsState {
   const Context* ctx;
   std::string folder;  // the scene's folder, resolved
+  std::vector<std::string>* read;  // the files read, resolved
 };
 
 // The resolved path if `path` is a regular file inside the scene's folder, else "".
@@ -52,7 +53,9 @@ bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const st
   }
   out->resize(size_t(size));
   in.seekg(0);
-  return bool(in.read(reinterpret_cast<char*>(out->data()), size));
+  if (!in.read(reinterpret_cast<char*>(out->data()), size)) return false;
+  fs.read->push_back(real);
+  return true;
 }
 
 bool write_whole_file(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
@@ -95,9 +98,9 @@ bool load_image(tinygltf::Image* image, const int index, std::string*, std::stri
 }  // namespace
 
 tinygltf::Model run_tinygltf(const Context& ctx, const std::string& bytes, const Parts& parts, const Checked& checked,
-                             Images& images) {
+                             Images& images, std::vector<std::string>& files_read) {
   tinygltf::TinyGLTF loader;
-  FsState fs{&ctx, ""};
+  FsState fs{&ctx, "", &files_read};
   if (!ctx.base_dir.empty()) {
     char buf[PATH_MAX];
     if (realpath(ctx.base_dir.c_str(), buf)) fs.folder = buf;

@@ -90,6 +90,9 @@ struct CameraDesc {
 
 struct SceneDesc {
   std::string source;  // file the scene came from (for messages)
+  // Other files the loader read (a .gltf's buffers and images), resolved: a checkpoint's
+  // fingerprint covers them (checkpoint.h).
+  std::vector<std::string> input_files;
   std::vector<Material> materials;
   std::vector<MeshDesc> meshes;
   std::vector<SphereDesc> spheres;

@@ -121,5 +121,40 @@ TEST(Checkpoint, AnotherRendersOrADamagedCheckpointIsRefused) {
   EXPECT_NE(window.output.find("--checkpoint needs -f"), std::string::npos) << window.output;
 }
 
+// A .gltf's buffers are part of the scene: a checkpoint of the scene before its .bin changed is
+// another render's, though the .gltf itself is the same.
+TEST(Checkpoint, AGltfWhoseBufferChangedIsAnotherRender) {
+  const std::string dir = test::temp_dir() + "/checkpoint_gltf";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  // A unit quad: four positions, then six 16-bit indices.
+  auto write_bin = [&](float x0) {
+    const float positions[12] = {x0, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+    std::ofstream bin(dir + "/quad.bin", std::ios::binary);
+    bin.write(reinterpret_cast<const char*>(positions), sizeof positions);
+    bin.write(reinterpret_cast<const char*>(indices), sizeof indices);
+  };
+  write_bin(-1);
+  std::ofstream(dir + "/quad.gltf")
+      << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+      "buffers": [{"uri": "quad.bin", "byteLength": 60}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+                    {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}]})";
+  const std::string cmd = "-t 2 -s 8 -m 3 -r 32 24 --quiet --checkpoint " + dir + "/c.ckpt -f " + dir + "/x.exr " + dir +
+                          "/quad.gltf";
+  RunResult first = run(cmd);
+  ASSERT_EQ(first.status, 0) << first.output;
+  RunResult same = run(cmd);
+  EXPECT_EQ(same.status, 0) << "the same files continue the checkpoint: " << same.output;
+  write_bin(-0.5f);  // inside the accessor's bounds: the scene still loads
+  RunResult changed = run(cmd);
+  EXPECT_EQ(changed.status, 1) << changed.output;
+  EXPECT_NE(changed.output.find("a checkpoint of another render"), std::string::npos) << changed.output;
+  EXPECT_NE(changed.output.find("quad.bin"), std::string::npos) << "it names the file: " << changed.output;
+}
+
 }  // namespace
 }  // namespace pt

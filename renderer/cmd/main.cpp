@@ -113,6 +113,7 @@ int main(int argc, char** argv) {
       for (const std::string& h : render_hints(o, scene->features, scene->camera, desc.geometry_bounds(), course_framing))
         std::fprintf(stderr, "hint: %s\n", h.c_str());
     }
+    const std::vector<std::string> input_files = desc.input_files;  // for the checkpoint's fingerprint
     desc = SceneDesc();  // the render scene holds what rendering reads: drop the file's copy
     if (!o.quiet)
       std::fprintf(stderr, "Loaded %s: %zu triangles, %zu spheres, %zu lights in %.3f s\n", o.scene_path.c_str(),
@@ -144,7 +145,7 @@ int main(int argc, char** argv) {
     if (!o.checkpoint.empty()) {
       std::ifstream scene_file(o.scene_path, std::ios::binary);
       checkpoints = std::make_unique<Checkpointer>(
-          o.checkpoint, render_fingerprint(std::string(std::istreambuf_iterator<char>(scene_file), {}), o.params),
+          o.checkpoint, render_fingerprint(std::string(std::istreambuf_iterator<char>(scene_file), {}), o.params, input_files),
           o.checkpoint_interval);
       restored = checkpoints->restore(session, driver);
       if (restored && !o.quiet)
