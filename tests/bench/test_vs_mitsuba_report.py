@@ -48,6 +48,16 @@ class Report(unittest.TestCase):
                       report([good]))
         self.assertIn("not met on this host (lowest 1.25x: dof; 1 of 2 cases below 1.50x)", report([good, weak]))
 
+    def test_the_time_split_says_how_much_of_our_own_work_the_targets_ask_to_cut(self):
+        # Mitsuba: 4 M samples/s = 0.25 us, 60% queries (0.15), 0.10 around. Ours: 2 M = 0.5 us,
+        # half queries (0.25), 0.25 around. Parity needs 0.25 of our 0.25 us of own work: out of reach.
+        # At efficiency 1.2x, 1.5x needs our time x 0.8: 0.1 us, 40% of our own work.
+        lines = vm.time_split(4e6, 0.6, 2e6, 0.5, 1.2)
+        self.assertIn("our queries 1.67x, our own work 2.50x", lines[0])
+        self.assertIn("samples/s parity out of reach by our own work alone; 1.5x efficiency cut by 40%", lines[1])
+        lines = vm.time_split(4e6, 0.6, 3e6, 0.5, 2.0)  # 0.333 us, 0.1667 own: parity cuts 0.0833 = 50%
+        self.assertIn("samples/s parity cut by 50%; 1.5x efficiency met", lines[1])
+
 
 if __name__ == "__main__":
     unittest.main()
