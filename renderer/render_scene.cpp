@@ -196,7 +196,8 @@ SceneBase make_scene_base(const SceneDesc& desc) {
   base.camera = desc.camera;
   base.bounds = desc.geometry_bounds();
   base.caustic_targets = find_caustic_targets(desc, base.materials);
-  base.emitters_share_a_plane = emitters_share_a_plane(desc, base.materials);
+  // Only light paths read it, and they need something to aim at: other scenes skip the scan.
+  base.emitters_share_a_plane = !base.caustic_targets.empty() && emitters_share_a_plane(desc, base.materials);
   // Each object's box, padded as Accel pads the scene's (relative to the largest coordinate).
   for (const MeshDesc& m : desc.meshes) {
     Bounds3 b;
