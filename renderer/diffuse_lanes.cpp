@@ -1,20 +1,20 @@
 // Diffuse vertices in SSE2 or AVX2 lanes (see diffuse_lanes.h): diffuse_lanes_body.inc, compiled
-// in lane_math.h's lane4 and lane8 namespaces. The physics is lane_physics.inc's at every width,
-// so each lane computes the scalar path_step's bits.
+// in lane_math.h's lane4 and lane8 namespaces. The scalar path_step runs the same text in lane1,
+// so each lane computes its bits.
 #include "diffuse_lanes.h"
 
 #include "lane_math.h"
 
 // SSE2: four lanes, the portable build.
 namespace pt::lane4 {
-using lanes::DiffuseVertices;
+using lanes::DiffuseVerticesN;
 #include "diffuse_lanes_body.inc"
 }  // namespace pt::lane4
 
 // AVX2: eight lanes, for the CPUs that have it (PT_BEGIN_AVX2 in simd.h).
 PT_BEGIN_AVX2
 namespace pt::lane8 {
-using lanes::DiffuseVertices;
+using lanes::DiffuseVerticesN;
 #include "diffuse_lanes_body.inc"
 }  // namespace pt::lane8
 PT_END_AVX2

@@ -1,5 +1,6 @@
-// The path loop (integrator.cpp): one camera path's radiance, one path at a time or many at once in
-// Embree packets, specialised on the scene's feature bits. Below the session, which drives it.
+// The path loop: one camera path's radiance, one path at a time (integrator.cpp) or many at once in
+// Embree packets (path_pool.cpp), both running path_vertex.h's vertex, specialised on the scene's
+// feature bits. Below the session, which drives it.
 #pragma once
 
 #include <cstdint>
@@ -35,8 +36,9 @@ PathTracer path_tracer_for(uint32_t feature_bits);
 using PathBatchTracer = void (*)(const RenderScene&, const PathSettings&, const Ray* camera_rays, class Sampler* rngs,
                                  size_t n, Vec3* out, uint64_t& rays);
 PathBatchTracer path_batch_tracer_for(uint32_t feature_bits, const PathSettings& settings);
-// Whether the batched loop takes its diffuse vertices in SIMD lanes (diffuse_lanes.h): lanes on
-// (LoopForms), every light an area light (rectangle or mesh), light sampling (not -H).
+// Whether diffuse vertices take the lanes' text (diffuse_lanes.h), in SIMD lanes in the batched
+// loop and at width 1 in the path-by-path one: lanes on (LoopForms), every light an area light
+// (rectangle or mesh), light sampling (not -H).
 bool diffuse_lanes_apply(const RenderScene& scene, const PathSettings& settings);
 // Whether packets take their Sobol draws eight at a time (Sampler::next_2d_many / sobol_draws):
 // the Sobol sampler, lanes on, and a CPU with AVX2.

@@ -22,7 +22,7 @@ struct BsdfSample {
 // The Lambertian lobe (lane_physics.inc, which the lanes share), inline so that integrators
 // specialised for diffuse-only scenes call it directly; the switches in materials.cpp use it too.
 inline Vec3 diffuse_eval(const Material& m, Vec3 wo, Vec3 wi) { return lane1::diffuse_eval(m.albedo, wo, wi); }
-inline float diffuse_pdf(Vec3 wo, Vec3 wi) { return lane1::diffuse_pdf(wo, wi); }
+using lane1::diffuse_pdf;  // one function for path_step and the lanes' text at width 1
 inline bool diffuse_sample(const Material& m, Vec3 wo, Vec2 u, BsdfSample& s) {
   s.delta = false;
   s.weight = m.albedo;  // (albedo / pi) * cos / (cos / pi)

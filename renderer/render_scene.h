@@ -64,7 +64,10 @@ struct SceneBase {
 // off on a view to compare the forms, which render the same images.
 struct LoopForms {
   bool packets = true;  // camera paths many at once, their rays in Embree packets (-H: never)
-  bool lanes = true;    // packets' diffuse vertices and sample draws in SIMD lanes
+  // Diffuse vertices under area lights by the lanes' text (diffuse_lanes.h: one path at a time at
+  // width 1, packets' vertices four or eight at a time), packets' sample draws in SIMD lanes. False:
+  // path_step's generic vertex, the reference the tests compare the lanes with.
+  bool lanes = true;
 };
 
 struct RenderScene {

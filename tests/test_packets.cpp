@@ -91,9 +91,9 @@ TEST(Packets, BatchedPathsRenderWhatThePathByPathLoopRenders) {
   }
 }
 
-// The SSE2 lanes (diffuse_lanes.h) repeat path_step's arithmetic operation for operation: with
-// them and without, the batched loop must render the same bits, count the same rays and stop
-// the same pixels. Depth 8 makes paths reach Russian roulette (from the sixth vertex).
+// The SSE2 and AVX2 lanes (diffuse_lanes.h) repeat path_step's generic vertex operation for
+// operation: with them and without, the batched loop must render the same bits, count the same
+// rays and stop the same pixels. Depth 8 makes paths reach Russian roulette (from the sixth vertex).
 TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
   std::vector<Case> all = cases();
   for (Case& c : all) c.params.max_depth = 8;
@@ -127,6 +127,35 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
     }
   }
   EXPECT_GE(laned, 6) << "the own scenes' lights take the lanes: rectangles (1 or 3 samples), a mesh";
+}
+
+// Path by path, the lanes' text runs at width 1 (path_step's diffuse_vertex): it must render the
+// bits of the generic vertex it stands in for, with the same rays and adaptive stops.
+TEST(Packets, TheLanesTextAtWidthOneRendersTheGenericVertexBits) {
+  std::vector<Case> all = cases();
+  for (Case& c : all) c.params.max_depth = 8;  // into Russian roulette
+  all.push_back({"cornell with a mesh light, depth 8", "", all[0].params});
+  int laned = 0;
+  for (const Case& c : all) {
+    SCOPED_TRACE(c.name);
+    SceneDesc desc = load_collada(c.path.empty() ? test::own_scene("cornell.dae") : c.path);
+    if (c.path.empty()) test::area_lights_as_meshes(desc);
+    RenderParams p = c.params;
+    auto scene = make_render_scene(desc, p);
+    scene->loop.packets = false;
+    laned += diffuse_lanes_apply(*scene, PathSettings(p));
+    RenderScene generic = *scene;
+    generic.loop.lanes = false;
+    RenderSession with(*scene, p), without(generic, p);
+    with.render_all();
+    without.render_all();
+    ImageRGB a = with.image(), b = without.image();
+    ASSERT_EQ(a.pixels.size(), b.pixels.size());
+    EXPECT_EQ(differing_pixels(a, b), 0u);
+    EXPECT_EQ(with.stats().rays, without.stats().rays);
+    EXPECT_EQ(with.film().done_mask(), without.film().done_mask());
+  }
+  EXPECT_GE(laned, 5) << "the own scenes' lights take the lanes' text: rectangles (1 or 3 samples), a mesh";
 }
 
 TEST(Packets, DiffuseLanesTakeOnlyAreaLights) {

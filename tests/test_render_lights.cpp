@@ -120,7 +120,7 @@ TEST(AmbientRender, DiffuseSphereUnderTheSkyMatchesTheFormula) {
     ASSERT_GT(r.n, 1000) << "depth " << m;
     EXPECT_NEAR(r.mean, 0, 4.5 * r.stderr_ + 1e-3 * mean_expected) << "depth " << m << ", expected mean " << mean_expected;
     EXPECT_LT(4.5 * r.stderr_, 0.02 * mean_expected) << "too noisy to catch a wrong sky";
-    // Camera rays do not see the ambient light itself (integrator.cpp, as the course): the
+    // Camera rays do not see the ambient light itself (path_vertex.h, as the course): the
     // background is black above the horizon (top rows) and below it.
     EXPECT_EQ(test::region_stats(img, 0, 0, 64, 2).mean, 0.0) << "depth " << m;
     EXPECT_EQ(test::region_stats(img, 0, 62, 64, 64).mean, 0.0) << "depth " << m;
