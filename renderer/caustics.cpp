@@ -151,35 +151,30 @@ bool boxes_touch(const Bounds3& a, const Bounds3& b, float pad) {
 bool emitters_share_a_plane(const SceneDesc& desc, const std::vector<Material>& materials) {
   constexpr size_t kMaxFaces = 32;  // past this many emitting faces, assume they may
   std::vector<EmitterFace> faces;
-  auto face = [&](Vec3 a, Vec3 b, Vec3 c, int owner) {
-    Vec3 n = cross(b - a, c - a);
+  // A planar face through corners v[0, count): its plane from the first three, its box from all.
+  auto face = [&](const Vec3* v, int count, int owner) {
+    Vec3 n = cross(v[1] - v[0], v[2] - v[0]);
     float len = length(n);
     if (!(len > 0)) return;
     EmitterFace f{n / len, 0, {}, owner};
-    f.d = dot(f.n, a);
-    for (Vec3 v : {a, b, c}) f.box.expand(v);
+    f.d = dot(f.n, v[0]);
+    for (int k = 0; k < count; ++k) f.box.expand(v[k]);
     faces.push_back(f);
   };
   const int meshes = int(desc.meshes.size());
-  // A rectangle as the triangles (a, b, c) and (a, c, d).
-  auto rect = [&](const LightDesc& l, Vec3 out[4]) {
-    Vec3 hx = l.dim_x * 0.5f, hy = l.dim_y * 0.5f;
-    out[0] = l.position - hx - hy, out[1] = l.position + hx - hy, out[2] = l.position + hx + hy,
-    out[3] = l.position - hx + hy;
-  };
   for (size_t i = 0; i < desc.lights.size(); ++i) {
     if (desc.lights[i].type != LightType::area) continue;
-    Vec3 q[4];
-    rect(desc.lights[i], q);
-    face(q[0], q[1], q[2], meshes + int(i));
-    if (!faces.empty() && faces.back().owner == meshes + int(i)) faces.back().box.expand(q[3]);
+    Vec3 corners[4];
+    area_light_corners(desc.lights[i], corners);
+    face(corners, 4, meshes + int(i));
   }
   for (size_t m = 0; m < desc.meshes.size(); ++m) {
     const MeshDesc& mesh = desc.meshes[m];
     for (size_t t = 0; t < mesh.tri_material.size() && faces.size() <= kMaxFaces; ++t) {
       if (!is_emissive(materials[size_t(mesh.tri_material[t])])) continue;
       const uint32_t* v = &mesh.indices[3 * t];
-      face(mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], int(m));
+      const Vec3 corners[3] = {mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]]};
+      face(corners, 3, int(m));
     }
   }
   if (faces.size() > kMaxFaces) return true;
@@ -213,7 +208,7 @@ bool emitters_share_a_plane(const SceneDesc& desc, const std::vector<Material>& 
   for (size_t i = 0; i < desc.lights.size(); ++i) {
     if (desc.lights[i].type != LightType::area) continue;
     Vec3 q[4];
-    rect(desc.lights[i], q);
+    area_light_corners(desc.lights[i], q);
     if (overlaps(q[0], q[1], q[2], meshes + int(i), true) || overlaps(q[0], q[2], q[3], meshes + int(i), true))
       return true;
   }

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "options.h"
 
@@ -20,24 +21,34 @@ constexpr char kMagic[8] = {'P', 'T', 'C', 'H', 'E', 'C', 'K', '2'};
 constexpr size_t kMaxFingerprint = 1 << 16;
 
 // FNV-1a, 64 bits: a scene's identity, not a defence against forgery (a checkpoint is our own file).
-uint64_t fnv1a(const std::string& bytes) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
+constexpr uint64_t kFnvOffset = 1469598103934665603ull;
+uint64_t fnv1a(const char* bytes, size_t n, uint64_t h = kFnvOffset) {
+  for (size_t i = 0; i < n; ++i) h = (h ^ static_cast<unsigned char>(bytes[i])) * 1099511628211ull;
   return h;
 }
+uint64_t fnv1a(const std::string& bytes) { return fnv1a(bytes.data(), bytes.size()); }
 
 [[noreturn]] void fail_io(const std::string& path, const char* doing) {
   throw std::runtime_error(path + ": cannot " + doing + " the checkpoint (" + std::strerror(errno) + ")");
 }
 
-// "HASH (N bytes)" of a file's contents, or "unreadable".
+// "HASH (N bytes)" of a file's contents, or "unreadable". Read in chunks: a glTF buffer or an
+// environment map may be large, and only its hash is kept.
 std::string file_digest(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return "unreadable";
-  std::string bytes(std::istreambuf_iterator<char>(in), {});
+  uint64_t h = kFnvOffset, size = 0;
+  std::vector<char> chunk(1 << 16);
+  while (in) {
+    in.read(chunk.data(), std::streamsize(chunk.size()));
+    const size_t got = size_t(in.gcount());
+    h = fnv1a(chunk.data(), got, h);
+    size += got;
+  }
+  if (in.bad()) return "unreadable";
   char hash[20];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(bytes)));
-  return std::string(hash) + " (" + std::to_string(bytes.size()) + " bytes)";
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(h));
+  return std::string(hash) + " (" + std::to_string(size) + " bytes)";
 }
 
 }  // namespace

@@ -75,9 +75,7 @@ SceneBase make_scene_base(const SceneDesc& desc) {
         }
         // The panel is visible to rays and emits on the side it faces.
         EmitterPanel p;
-        Vec3 c = ld.position, hx = ld.dim_x * 0.5f, hy = ld.dim_y * 0.5f;
-        p.v[0] = c - hx - hy; p.v[1] = c + hx - hy; p.v[2] = c + hx + hy; p.v[3] = c - hx + hy;
-        if (dot(cross(ld.dim_x, ld.dim_y), ld.direction) < 0) std::swap(p.v[1], p.v[3]);
+        area_light_corners(ld, p.v);
         Material em;
         em.name = ld.name + " (panel)";
         em.type = MaterialType::emission;

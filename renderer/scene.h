@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "math.h"
@@ -59,6 +60,15 @@ struct LightDesc {
   // falls as KHR_lights_punctual recommends (squared, linear in the cosine). < 0: no such cone.
   float spot_inner_deg = -1;
 };
+
+// An area light's rectangle: its four corners in order around its edges, wound counter-clockwise
+// seen from the side it faces (cross(v[1] - v[0], v[2] - v[0]) along `direction`). The visible
+// panel, the light-plane scan (caustics.cpp) and the tests' meshed lights all take these.
+inline void area_light_corners(const LightDesc& l, Vec3 v[4]) {
+  const Vec3 c = l.position, hx = l.dim_x * 0.5f, hy = l.dim_y * 0.5f;
+  v[0] = c - hx - hy, v[1] = c + hx - hy, v[2] = c + hx + hy, v[3] = c - hx + hy;
+  if (dot(cross(l.dim_x, l.dim_y), l.direction) < 0) std::swap(v[1], v[3]);
+}
 
 struct MeshDesc {
   std::string name;

@@ -168,10 +168,10 @@ inline void area_lights_as_meshes(SceneDesc& desc) {
     desc.materials.push_back(em);
     MeshDesc m;
     m.name = l.name;
-    Vec3 hx = l.dim_x * 0.5f, hy = l.dim_y * 0.5f;
-    m.positions = {l.position - hx - hy, l.position + hx - hy, l.position + hx + hy, l.position - hx + hy};
-    if (dot(cross(l.dim_x, l.dim_y), l.direction) > 0) m.indices = {0, 1, 2, 0, 2, 3};
-    else m.indices = {0, 2, 1, 0, 3, 2};
+    Vec3 corners[4];
+    area_light_corners(l, corners);
+    m.positions.assign(corners, corners + 4);
+    m.indices = {0, 1, 2, 0, 2, 3};
     m.tri_material = {int(desc.materials.size()) - 1, int(desc.materials.size()) - 1};
     desc.meshes.push_back(m);
   }
