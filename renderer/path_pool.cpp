@@ -193,8 +193,10 @@ void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const
           s.contribution = contribution;
         }
       } shadow{shadows, uint32_t(i)};
+      // Diffuse vertices with depth left went to the lanes above: path_step's own width-1 route
+      // for them is left out of this loop (`false`), and with it its code.
       alive[i] = path_step<F>(scene, settings, slots[i].st, found[i] != 0, hits[i], rngs[slots[i].job], rays, shadow,
-                              use_lanes);
+                              false);
     }
     if (n_lanes)
       diffuse_in_lanes(scene, settings, *lane_data, in_lanes.data(), int(n_lanes), slots, rngs, hits.data(), alive.data(),
