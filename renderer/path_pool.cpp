@@ -75,8 +75,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
     v.ubx[j] = u[size_t(j)].x, v.uby[j] = u[size_t(j)].y;
     v.roulette[j] = st.bounce >= kRouletteStart;
     v.urr[j] = v.roulette[j] ? samplers[size_t(j)]->next_float() : 0.0f;
-    st.has_direct = true;
-    st.direct_beta = st.beta;
+    st.start_diffuse_vertex();
   }
   for (size_t l = 0; l < nl; ++l) {
     const Light& light = scene.lights[l / size_t(settings.light_samples)];
@@ -96,11 +95,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
     const size_t first = shadows.n;
     for (int j = 0; j < n; ++j) {
       if (!v.shadow[j]) continue;
-      Ray& r = shadows.rays[shadows.n];
-      r.o = Vec3(v.sox[j], v.soy[j], v.soz[j]);
-      r.d = Vec3(v.sdx[j], v.sdy[j], v.sdz[j]);
-      r.tmin = 0;
-      r.tmax = kShadowRayEnd;  // as spawn_ray_to
+      lane_shadow_ray(v, j, shadows.rays[shadows.n]);
       PendingShadow& s = shadows.pending[shadows.n++];
       s.slot = which[j];
       s.contribution = Vec3(v.cx[j], v.cy[j], v.cz[j]);
@@ -115,12 +110,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
     alive[i] = v.alive[j] != 0;
     if (!alive[i]) continue;
     st.beta = Vec3(v.bx[j], v.by[j], v.bz[j]);
-    st.specular = false;
-    if (bounce == 0) st.caustic_phase = 1;
-    else if (st.caustic_phase == 2) st.caustic_phase = 0;
-    st.prev_pdf = v.pdf[j];
-    st.prev_p = hits[i].p;
-    --st.depth_left;
+    st.took_diffuse_bounce(bounce, v.pdf[j], hits[i].p);
     st.ray.o = Vec3(v.ox[j], v.oy[j], v.oz[j]);
     st.ray.d = Vec3(v.wx[j], v.wy[j], v.wz[j]);
     st.ray.tmin = 0;

@@ -158,6 +158,21 @@ struct PathState {
     depth_left = max_depth;
     bounce = 0;
   }
+  // A diffuse vertex's start and its bounce, as the lanes' text takes them at any width: its light
+  // sampling weighed by the throughput it arrived with, then the bounce's bookkeeping (vertex
+  // number `bounce`, its pdf, at point p).
+  void start_diffuse_vertex() {
+    has_direct = true;
+    direct_beta = beta;
+  }
+  void took_diffuse_bounce(int bounce, float pdf, Vec3 p) {
+    specular = false;
+    if (bounce == 0) caustic_phase = 1;
+    else if (caustic_phase == 2) caustic_phase = 0;
+    prev_pdf = pdf;
+    prev_p = p;
+    --depth_left;
+  }
   // Adds the current vertex's light sampling, after its shadow rays (and before the next vertex).
   void resolve_direct() {
     if (has_direct) radiance += direct_beta * direct_sum;
@@ -165,6 +180,15 @@ struct PathState {
     direct_sum = Vec3(0.0f);
   }
 };
+
+// Slot i's shadow ray out of the lanes' light_pass, written into r (as spawn_ray_to ends it).
+template <int N>
+inline void lane_shadow_ray(const lanes::DiffuseVerticesN<N>& v, int i, Ray& r) {
+  r.o = Vec3(v.sox[i], v.soy[i], v.soz[i]);
+  r.d = Vec3(v.sdx[i], v.sdy[i], v.sdz[i]);
+  r.tmin = 0;
+  r.tmax = kShadowRayEnd;
+}
 
 // path_step's diffuse vertex under area lights (diffuse_lanes_apply): diffuse_lanes_body.inc at
 // width 1, the text the pool's lanes run four or eight at a time (diffuse_in_lanes). The draws in
@@ -181,8 +205,7 @@ bool diffuse_vertex(const RenderScene& scene, const PathSettings& settings, Path
   v.ax[0] = material.albedo.x, v.ay[0] = material.albedo.y, v.az[0] = material.albedo.z;
   v.dx[0] = st.ray.d.x, v.dy[0] = st.ray.d.y, v.dz[0] = st.ray.d.z;
   v.bx[0] = st.beta.x, v.by[0] = st.beta.y, v.bz[0] = st.beta.z;
-  st.has_direct = true;
-  st.direct_beta = st.beta;
+  st.start_diffuse_vertex();
   for (const Light& light : scene.lights) {
     for (int k = 0; k < settings.light_samples; ++k) {
       const Vec2 u = rng.next_2d();
@@ -197,11 +220,7 @@ bool diffuse_vertex(const RenderScene& scene, const PathSettings& settings, Path
       lane1::light_pass(v, 1, light, settings.light_samples);
       if (!v.shadow[0]) continue;
       ++rays;
-      Ray& r = shadow.ray();
-      r.o = Vec3(v.sox[0], v.soy[0], v.soz[0]);
-      r.d = Vec3(v.sdx[0], v.sdy[0], v.sdz[0]);
-      r.tmin = 0;
-      r.tmax = kShadowRayEnd;  // as spawn_ray_to
+      lane_shadow_ray(v, 0, shadow.ray());
       shadow.add(Vec3(v.cx[0], v.cy[0], v.cz[0]));
     }
   }
@@ -213,12 +232,7 @@ bool diffuse_vertex(const RenderScene& scene, const PathSettings& settings, Path
   lane1::bounce_pass(v, 1);
   if (!v.alive[0]) return false;
   st.beta = Vec3(v.bx[0], v.by[0], v.bz[0]);
-  st.specular = false;
-  if (bounce == 0) st.caustic_phase = 1;
-  else if (st.caustic_phase == 2) st.caustic_phase = 0;
-  st.prev_pdf = v.pdf[0];
-  st.prev_p = hit.p;
-  --st.depth_left;
+  st.took_diffuse_bounce(bounce, v.pdf[0], hit.p);
   st.ray.o = Vec3(v.ox[0], v.oy[0], v.oz[0]);
   st.ray.d = Vec3(v.wx[0], v.wy[0], v.wz[0]);
   st.ray.tmin = 0;
