@@ -6,6 +6,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -45,7 +46,11 @@ struct GeomInfo {
   const uint32_t* indices = nullptr;  // Embree-owned index buffer
   std::vector<float> normals;         // shading normals, 3 floats a vertex and 1 of padding; empty for flat meshes
   std::vector<TriangleInfo> tris;     // per triangle
-  std::vector<float> attributes;      // u v r g b a vertex; empty for meshes without uvs and colours
+  // Vertex attributes for Accel::attributes, each empty when the mesh has none.
+  std::vector<Vec2> uv0, uv1;
+  std::vector<Vec3> colors;
+  std::vector<std::array<float, 4>> tangents;
+  bool has_attributes() const { return !uv0.empty() || !uv1.empty() || !colors.empty() || !tangents.empty(); }
   const float* spheres = nullptr;     // x y z r per sphere
   std::vector<float> sphere_data;     // what `spheres` points to (Embree user geometry reads it)
   std::vector<int> sphere_material;
@@ -187,7 +192,9 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
       Vec3 p0 = pos[tri[0]], p1 = pos[tri[1]], p2 = pos[tri[2]];
       info.tris[t] = {normalize(cross(p1 - p0, p2 - p0)), tri_material[t], tri_light.empty() ? -1 : tri_light[t]};
     }
-    a.bytes += (info.normals.size() + info.attributes.size()) * sizeof(float) + info.tris.size() * sizeof(TriangleInfo);
+    a.bytes += info.normals.size() * sizeof(float) + info.tris.size() * sizeof(TriangleInfo) +
+               (info.uv0.size() + info.uv1.size()) * sizeof(Vec2) + info.colors.size() * sizeof(Vec3) +
+               info.tangents.size() * 4 * sizeof(float);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a.scene, g);
     rtcReleaseGeometry(g);
@@ -207,14 +214,12 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
       for (Vec3 n : mesh.normals) info.normals.insert(info.normals.end(), {n.x, n.y, n.z});
       info.normals.push_back(0.0f);
     }
-    if (!mesh.uvs.empty() || !mesh.colors.empty()) {  // absent ones read as uv (0, 0), colour white
-      info.attributes.reserve(5 * mesh.positions.size());
-      for (size_t v = 0; v < mesh.positions.size(); ++v) {
-        Vec2 uv = v < mesh.uvs.size() ? mesh.uvs[v] : Vec2{};
-        Vec3 c = v < mesh.colors.size() ? mesh.colors[v] : Vec3(1.0f);
-        info.attributes.insert(info.attributes.end(), {uv.x, uv.y, c.x, c.y, c.z});
-      }
-    }
+    // Attributes with one value a vertex are kept (the loaders give all or none).
+    const size_t nv = mesh.positions.size();
+    if (mesh.uvs.size() == nv) info.uv0 = mesh.uvs;
+    if (mesh.uvs1.size() == nv) info.uv1 = mesh.uvs1;
+    if (mesh.colors.size() == nv) info.colors = mesh.colors;
+    if (mesh.tangents.size() == nv) info.tangents = mesh.tangents;
     static const std::vector<int> none;
     add_triangles(mesh.positions, mesh.indices, mesh.tri_material, m < mesh_light.size() ? mesh_light[m] : none,
                   std::move(info));
@@ -263,10 +268,12 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     if (a.geoms.size() <= id) a.geoms.resize(id + 1);
     a.geoms[id] = std::move(info);
   }
-  for (const GeomInfo& g : a.geoms) a.attributes |= !g.attributes.empty();
-  for (GeomInfo& g : a.geoms)  // the vectors' buffers are where they stay
+  for (const GeomInfo& g : a.geoms) a.attributes |= g.has_attributes();
+  for (size_t id = 0; id < a.geoms.size(); ++id) {  // the vectors' buffers are where they stay
+    GeomInfo& g = a.geoms[id];
     g.triangles = {g.positions, g.indices, g.normals.empty() ? nullptr : g.normals.data(), g.tris.data(),
-                   g.attributes.empty() ? nullptr : g.attributes.data()};
+                   uint32_t(id), g.has_attributes()};
+  }
 
   rtcCommitScene(a.scene);
   a.check("building the BVH");
@@ -460,6 +467,28 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
   if (a.attributes) refine_hit<true>(g, ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v, eng, hit);
   else refine_hit<false>(g, ray, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v, eng, hit);
   return true;
+}
+
+HitAttributes Accel::attributes(const SurfaceHit& hit) const {
+  HitAttributes out;
+  const Impl& a = *m_impl;
+  if (hit.geom >= a.geoms.size()) return out;
+  const GeomInfo& g = a.geoms[hit.geom];
+  if (g.kind == GeomKind::spheres || size_t(hit.prim) >= g.tris.size()) return out;
+  const uint32_t* tri = g.indices + 3 * size_t(hit.prim);
+  const float w = 1 - hit.bu - hit.bv, u = hit.bu, v = hit.bv;
+  auto mix2 = [&](const std::vector<Vec2>& x) {
+    return Vec2{x[tri[0]].x * w + x[tri[1]].x * u + x[tri[2]].x * v, x[tri[0]].y * w + x[tri[1]].y * u + x[tri[2]].y * v};
+  };
+  if (!g.uv0.empty()) out.uv[0] = mix2(g.uv0);
+  if (!g.uv1.empty()) out.uv[1] = mix2(g.uv1);
+  if (!g.colors.empty()) out.color = g.colors[tri[0]] * w + g.colors[tri[1]] * u + g.colors[tri[2]] * v;
+  if (!g.tangents.empty()) {
+    const auto &t0 = g.tangents[tri[0]], &t1 = g.tangents[tri[1]], &t2 = g.tangents[tri[2]];
+    out.tangent = Vec3(t0[0], t0[1], t0[2]) * w + Vec3(t1[0], t1[1], t1[2]) * u + Vec3(t2[0], t2[1], t2[2]) * v;
+    out.sign = t0[3] < 0 ? -1.0f : 1.0f;
+  }
+  return out;
 }
 
 bool Accel::occluded(const Ray& ray) const {

@@ -22,21 +22,28 @@ struct EmitterPanel {
 };
 
 struct SurfaceHit {
-  float t = kInf;
   Vec3 p;            // hit point, refined from barycentrics or the sphere equation
   Vec3 ng;           // unit geometric normal: triangle winding side / sphere outside
   Vec3 ns;           // unit shading normal on the same side as ng
   int material = -1;
   int light = -1;    // >= 0 when the surface is an emitter registered as a light
   float offset = 0;  // how far to push spawned rays off the surface (scale-aware)
-  // Interpolated texture coordinates and vertex colour (8-bit sRGB, as precise as a colour
-  // texture): written only for meshes that carry them (MeshDesc::uvs / colors), read only for
-  // textured materials (Material::textured). They keep the record at 64 bytes, a power of two:
-  // the path loops index arrays of hits with a shift.
-  Vec2 uv;
-  uint8_t color[3];
+  // Where the hit lies on a mesh that carries attributes (uvs, colours, tangents): written only in
+  // scenes with such meshes, read only by Accel::attributes for textured materials. The record
+  // stays at 64 bytes, a power of two: the path loops index arrays of hits with a shift.
+  uint32_t geom = 0, prim = 0;
+  float bu = 0, bv = 0;  // barycentrics of vertices 1 and 2
 };
 static_assert(sizeof(SurfaceHit) == 64, "SurfaceHit: 64 bytes, a power of two");
+
+// A mesh's vertex attributes interpolated at a hit (Accel::attributes): what the mesh lacks reads
+// as uv (0, 0), colour white, no tangent.
+struct HitAttributes {
+  Vec2 uv[2];
+  Vec3 color{1, 1, 1};
+  Vec3 tangent;     // world space, not normalised; zero when the mesh has none
+  float sign = 1;   // the bitangent's handedness
+};
 
 class Accel {
  public:
@@ -49,6 +56,8 @@ class Accel {
   Accel& operator=(const Accel&) = delete;
 
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  // The vertex attributes at a hit on a mesh that carries them (SurfaceHit::geom, prim, bu, bv).
+  HitAttributes attributes(const SurfaceHit& hit) const;
   // True when anything blocks the ray within [ray.tmin, ray.tmax].
   bool occluded(const Ray& ray) const;
   // The same queries for n rays at once, traced in Embree packets of packet_width() rays (faster

@@ -15,7 +15,6 @@
 
 #include "accel.h"
 #include "math.h"
-#include "texture.h"
 
 namespace pt {
 
@@ -176,17 +175,16 @@ struct TriangleData {
   const uint32_t* indices;
   const float* normals;  // shading normals, or null for a flat mesh
   const TriangleInfo* tris;
-  const float* attributes;  // u v r g b a vertex, or null for a mesh without uvs and colours
+  uint32_t geom_id;   // Embree's id of the mesh
+  bool attributes;    // the mesh has uvs, colours or tangents (Accel::attributes reads them)
 };
 
-// The texture coordinates and vertex colour at barycentrics (u, v), for meshes that have them.
-inline void interpolate_attributes(const TriangleData& m, const uint32_t* tri, float u, float v, SurfaceHit& hit) {
-  const float* a0 = m.attributes + 5 * size_t(tri[0]);
-  const float* a1 = m.attributes + 5 * size_t(tri[1]);
-  const float* a2 = m.attributes + 5 * size_t(tri[2]);
-  const float w = 1 - u - v;
-  hit.uv = Vec2{a0[0] * w + a1[0] * u + a2[0] * v, a0[1] * w + a1[1] * u + a2[1] * v};
-  for (int c = 0; c < 3; ++c) hit.color[c] = linear_to_srgb8(a0[2 + c] * w + a1[2 + c] * u + a2[2 + c] * v);
+// Where a hit lies, for Accel::attributes, on meshes that have attributes.
+inline void note_attributes(const TriangleData& m, unsigned prim, float u, float v, SurfaceHit& hit) {
+  hit.geom = m.geom_id;
+  hit.prim = prim;
+  hit.bu = u;
+  hit.bv = v;
 }
 
 // The hit record of a hit on triangle `prim` at t with barycentrics (u, v): the point from the
@@ -196,11 +194,11 @@ inline void interpolate_attributes(const TriangleData& m, const uint32_t* tri, f
 template <bool Attributes = true, class EmbreeNormal>
 inline void refine_triangle_scalar(const TriangleData& m, unsigned prim, float t, float u, float v, EmbreeNormal&& eng,
                                    SurfaceHit& hit) {
+  (void)t;  // the point comes from the barycentrics
   const uint32_t* tri = m.indices + 3 * size_t(prim);
   const TriangleInfo& info = m.tris[prim];
   auto at = [&](const float* base, uint32_t i) { return Vec3(base[3 * size_t(i)], base[3 * size_t(i) + 1], base[3 * size_t(i) + 2]); };
   const float w = 1 - u - v;
-  hit.t = t;
   hit.p = at(m.positions, tri[0]) * w + at(m.positions, tri[1]) * u + at(m.positions, tri[2]) * v;
   Vec3 ng = info.ng;
   if (is_black(ng)) {
@@ -216,7 +214,7 @@ inline void refine_triangle_scalar(const TriangleData& m, unsigned prim, float t
   hit.material = info.material;
   hit.light = info.light;
   hit.offset = 0;
-  if (Attributes && m.attributes) interpolate_attributes(m, tri, u, v, hit);
+  if (Attributes && m.attributes) note_attributes(m, prim, u, v, hit);
 }
 
 // The hit record of a hit on sphere s (centre x y z, radius) at t: the point re-projected onto the
@@ -226,7 +224,6 @@ inline void refine_sphere_scalar(const float* s, int material, const Ray& ray, f
   const float r = s[3];
   Vec3 n = normalize(ray.o + ray.d * t - c);
   if (is_black(n)) n = Vec3(0, 1, 0);
-  hit.t = t;
   hit.p = c + n * r;
   hit.ng = hit.ns = n;
   hit.material = material;
@@ -278,6 +275,7 @@ template <bool Attributes = true, class EmbreeNormal>
 [[gnu::always_inline]] inline void refine_triangle(const TriangleData& m, unsigned prim, float t, float u, float v,
                                                    EmbreeNormal&& eng, SurfaceHit& hit) {
 #if defined(__SSE2__)
+  (void)t;  // the point comes from the barycentrics
   const uint32_t* tri = m.indices + 3 * size_t(prim);
   const TriangleInfo& info = m.tris[prim];
   const __m128 W = _mm_set1_ps(1 - u - v), U = _mm_set1_ps(u), V = _mm_set1_ps(v);
@@ -293,11 +291,10 @@ template <bool Attributes = true, class EmbreeNormal>
     const __m128 n = sse::normalize3(sse::interpolate(m.normals, tri, W, U, V));
     if (!sse::is_black3(n)) ns = n;
   }
-  hit.t = t;
   sse::store_vectors(hit, p, ng, ns);
   std::memcpy(&hit.material, &info.material, 2 * sizeof(int));  // material and light, adjacent in both
   hit.offset = 0;
-  if (Attributes && m.attributes) interpolate_attributes(m, tri, u, v, hit);
+  if (Attributes && m.attributes) note_attributes(m, prim, u, v, hit);
 #else
   refine_triangle_scalar<Attributes>(m, prim, t, u, v, eng, hit);
 #endif
@@ -313,7 +310,6 @@ template <bool Attributes = true, class EmbreeNormal>
   __m128 n = sse::normalize3(_mm_sub_ps(_mm_add_ps(o, _mm_mul_ps(d, _mm_set1_ps(t))), sphere));
   if (sse::is_black3(n)) n = _mm_setr_ps(0, 1, 0, 0);
   const float r = s[3];
-  hit.t = t;
   sse::store_vectors(hit, _mm_add_ps(sphere, _mm_mul_ps(n, _mm_set1_ps(r))), n, n);
   hit.material = material;
   hit.light = -1;

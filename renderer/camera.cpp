@@ -134,6 +134,23 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
     c.tmin = authored.znear;
     c.tmax = authored.zfar;
     c.target = c.position - c.back;
+  } else if (authored.overview && !authored.present) {
+    // A glTF scene without a camera: from above and to the side (azimuth 45 degrees from +Z
+    // towards +X, elevation 30), far enough that the bounding sphere fits the 45-degree vertical
+    // field of view (wider images see more around it). Every face of a box shows.
+    const float v_fov = 45 * kDeg;
+    const Vec3 dir = normalize(Vec3(std::sin(45 * kDeg) * std::cos(30 * kDeg), std::sin(30 * kDeg),
+                                    std::cos(45 * kDeg) * std::cos(30 * kDeg)));
+    const float radius = b.empty() ? 1.0f : 0.5f * length(b.diagonal());
+    // A tall image's horizontal field is the narrower one: the sphere fits that.
+    const float tan_fit = std::tan(v_fov / 2) * std::min(1.0f, float(p.width) / float(std::max(1, p.height)));
+    float dist = 1.05f * radius / std::sin(std::atan(tan_fit));
+    if (!(dist > 0) || !std::isfinite(dist)) dist = 1;
+    c.target = b.empty() ? Vec3(0.0f) : b.center();
+    c.position = c.target + dir * dist;
+    set_basis(c, dir, Vec3(0, 1, 0));
+    c.screen_distance = float(p.height) / (2 * std::tan(v_fov / 2));
+    c.tmin = std::max(1e-4f, 1e-4f * dist);
   } else {
     // Course framing: orbit the bounding-box centre at 1.5x its diagonal, looking from the
     // direction of the camera node's matrix applied to the point (0, 0, -1); world up is +Y.
@@ -161,7 +178,8 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
   // keep_fov instead scales the course's 800-pixel-wide view to the output width; frame_scene
   // keeps the course's view direction and fits the field of view to the projected bounds (the
   // view looks at their centre, so a symmetric fit wastes little), with a 2% margin.
-  const bool course_framing = p.settings_file.empty() && !p.file_camera && !(authored.as_authored && authored.present);
+  const bool course_framing = p.settings_file.empty() && !p.file_camera && !(authored.as_authored && authored.present) &&
+                              !(authored.overview && !authored.present);
   float x0, x1, y0, y1;
   if (course_framing && p.frame_scene && projected_bounds(c, b, x0, x1, y0, y1)) {
     const float need_x = 1.02f * std::max(-x0, x1), need_y = 1.02f * std::max(-y0, y1);

@@ -258,8 +258,9 @@ bool start_light_path(const RenderScene& scene, const RenderParams& params, uint
   size_t chosen = 0;
   while (chosen + 1 < nt && pick >= cones[chosen].solid_angle) pick -= cones[chosen++].solid_angle;
   Vec3 wi = sample_cone(cones[chosen], u_dir);
+  n = facing_normal(light, n, wi);
   float cos_l = dot(wi, n);
-  if (!(cos_l > 0)) return false;  // emitters are one-sided
+  if (!(cos_l > 0)) return false;  // one-sided emitters light their front only
   int holding = 0;
   for (size_t k = 0; k < nt; ++k) holding += (k == chosen || dot(wi, cones[k].axis()) >= cones[k].cos_max);
   float pdf_dir = float(holding) / total;
@@ -301,7 +302,8 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
                      bool found, const SurfaceHit& hit, uint64_t& rays, Connect&& connect) {
   const int vertex = lp.vertex++;
   if (!found) return false;
-  const Material& m = material_at(scene, scene.materials[hit.material], hit);  // used within this call
+  Vec3 ns_at = hit.ns;  // scenes with light tracing have no normal maps (no glTF delta materials)
+  const Material& m = material_at(scene, scene.materials[hit.material], hit, ns_at);  // used within this call
   if (m.type == MaterialType::emission) return false;  // emitters reflect nothing
   const bool delta = is_delta(m);
   // Ours are L S+ D+ E: a first non-delta vertex ends a path with no delta bounce, and a delta

@@ -24,10 +24,4 @@ inline Vec3 radiometric_from_photometric(Vec3 color, double lumens_per_unit) {
   return color * float(lumens_per_unit / kLumensPerWatt);
 }
 
-// The artist-friendly conductor of Gulbrandsen 2014 ("Artist Friendly Metallic Fresnel", JCGT
-// 3(4), eqs. 3-4) with reflectance r at normal incidence and the edge tint taken equal to it: the
-// complex index eta + i k of our microfacet conductor whose Fresnel term gives r head on. Channels
-// are clamped to [0, 0.999].
-void conductor_from_reflectance(Vec3 r, Vec3& eta, Vec3& k);
-
 }  // namespace pt

@@ -18,8 +18,8 @@ void Checker::materials() {
       texture_info(*pbr, "baseColorTexture", at, true);
       texture_info(*pbr, "metallicRoughnessTexture", at, true);
     }
-    texture_info(m, "normalTexture", path);
-    texture_info(m, "occlusionTexture", path);
+    texture_info(m, "normalTexture", path, true);
+    texture_info(m, "occlusionTexture", path);  // a path tracer finds occlusion itself
     texture_info(m, "emissiveTexture", path, true);
     numbers(m, "emissiveFactor", path, 3, 0, 1);
     string(m, "alphaMode", path);
@@ -31,7 +31,13 @@ void Checker::materials() {
         number(*e, "emissiveStrength", at + "/KHR_materials_emissive_strength", false, 0, 1e30);
       if (const json* e = object(*ext, "KHR_materials_transmission", at)) {
         number(*e, "transmissionFactor", at + "/KHR_materials_transmission", false, 0, 1);
-        texture_info(*e, "transmissionTexture", at + "/KHR_materials_transmission");
+        texture_info(*e, "transmissionTexture", at + "/KHR_materials_transmission", true);
+      }
+      if (const json* e = object(*ext, "KHR_materials_specular", at)) {
+        number(*e, "specularFactor", at + "/KHR_materials_specular", false, 0, 1);
+        numbers(*e, "specularColorFactor", at + "/KHR_materials_specular", 3, 0, 1e3);
+        texture_info(*e, "specularTexture", at + "/KHR_materials_specular");
+        texture_info(*e, "specularColorTexture", at + "/KHR_materials_specular");
       }
       if (const json* e = object(*ext, "KHR_materials_ior", at)) {
         double ior = number(*e, "ior", at + "/KHR_materials_ior", false, 0, 1e3, 1.5);

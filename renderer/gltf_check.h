@@ -131,6 +131,14 @@ class Checker {
     integer(*t, "texCoord", at, false, 0, 255);
     number(*t, "scale", at, false, -1e9, 1e9, 1);
     number(*t, "strength", at, false, 0, 1, 1);
+    if (const json* ext = object(*t, "extensions", at))
+      if (const json* tt = object(*ext, "KHR_texture_transform", at + "/extensions")) {
+        const std::string tat = at + "/extensions/KHR_texture_transform";
+        numbers(*tt, "offset", tat, 2, -1e6, 1e6);
+        numbers(*tt, "scale", tat, 2, -1e6, 1e6);
+        number(*tt, "rotation", tat, false, -1e6, 1e6);
+        integer(*tt, "texCoord", tat, false, 0, 255);
+      }
     const json& texture = m_doc["textures"][size_t(tex)];
     if (read && texture.contains("source")) m_checked.decode_image[size_t(texture["source"].get<int64_t>())] = true;
   }

@@ -25,8 +25,10 @@ uint32_t read_u32(const std::string& b, size_t at) {
          uint32_t(uint8_t(b[at + 3])) << 24;
 }
 
-const char* const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                            "KHR_materials_transmission", "KHR_materials_ior", "KHR_mesh_quantization"};
+const char* const kSupportedExtensions[] = {"KHR_lights_punctual",        "KHR_materials_emissive_strength",
+                                            "KHR_materials_transmission", "KHR_materials_ior",
+                                            "KHR_materials_specular",     "KHR_texture_transform",
+                                            "KHR_mesh_quantization"};
 
 bool supported_extension(const std::string& name) {
   for (const char* e : kSupportedExtensions)
@@ -65,8 +67,11 @@ void Checker::asset_and_extensions() {
       const std::string name = (*list)[i].get<std::string>();
       if (supported_extension(name)) continue;
       if (key[10] == 'R')
-        fail(at, "extension '" + clip(name) + "' is required and not supported (supported: KHR_lights_punctual, "
-                 "KHR_materials_emissive_strength, KHR_materials_transmission, KHR_materials_ior, KHR_mesh_quantization)");
+      {
+        std::string list;
+        for (const char* e : kSupportedExtensions) list += std::string(list.empty() ? "" : ", ") + e;
+        fail(at, "extension '" + clip(name) + "' is required and not supported (supported: " + list + ")");
+      }
       m_ctx.warn("extension " + name, at, "extension '" + clip(name) + "' is not supported and is ignored");
     }
   }

@@ -1,40 +1,39 @@
-// glTF materials -> ours: pbrMetallicRoughness onto the nearer of our BSDFs (diffuse, the
-// microfacet conductor, the mirror), transmission onto glass, emission onto emitters; base colour
-// textures per hit on diffuse materials, their mean elsewhere. The mapping and what it
-// approximates: docs/gltf.md.
+// glTF materials -> ours: every glTF material is the pbr material (pbr.h), its factors read here
+// and its textures kept for the hits to read (textured_material): base colour, metal / roughness,
+// emission, normal map, transmission, each through its TEXCOORD set and KHR_texture_transform.
+// The mapping and what is left out: docs/gltf.md.
 #include <cmath>
 
+#include "ggx.h"
 #include "gltf_reader.h"
-#include "texture.h"
-
-namespace pt {
-
-void conductor_from_reflectance(Vec3 r, Vec3& eta, Vec3& k) {
-  for (int c = 0; c < 3; ++c) {
-    double f = std::min(std::max(double(r[c]), 0.0), 0.999), g = f;  // edge tint = reflectance
-    double sf = std::sqrt(f);
-    double n_min = (1 - f) / (1 + f), n_max = (1 + sf) / (1 - sf);
-    double n = g * n_min + (1 - g) * n_max;  // Gulbrandsen 2014, eq. 3
-    double k2 = ((n + 1) * (n + 1) * f - (n - 1) * (n - 1)) / (1 - f);  // eq. 4
-    eta[c] = float(n);
-    k[c] = float(std::sqrt(std::max(k2, 0.0)));
-  }
-}
-
-}  // namespace pt
 
 namespace pt::gltf_detail {
 
 namespace {
 
-// The value of a number in a material extension, or `def`.
-double extension_number(const tinygltf::ExtensionMap& ext, const char* name, const char* key, double def) {
+// The extension object `name` of a material, or nullptr.
+const tinygltf::Value* extension(const tinygltf::ExtensionMap& ext, const char* name) {
   auto it = ext.find(name);
-  if (it == ext.end() || !it->second.Has(key) || !it->second.Get(key).IsNumber()) return def;
-  return it->second.Get(key).GetNumberAsDouble();
+  return it == ext.end() || !it->second.IsObject() ? nullptr : &it->second;
 }
 
-Vec3 lerp(Vec3 a, Vec3 b, float t) { return a * (1 - t) + b * t; }
+double number(const tinygltf::Value* o, const char* key, double def) {
+  if (!o || !o->Has(key) || !o->Get(key).IsNumber()) return def;
+  return o->Get(key).GetNumberAsDouble();
+}
+
+Vec3 color3(const tinygltf::Value* o, const char* key, Vec3 def) {
+  if (!o || !o->Has(key)) return def;
+  const tinygltf::Value& a = o->Get(key);
+  if (!a.IsArray() || a.ArrayLen() != 3) return def;
+  Vec3 c;
+  for (int i = 0; i < 3; ++i) c[i] = float(a.Get(i).GetNumberAsDouble());
+  return c;
+}
+
+Vec3 factor3(const std::vector<double>& f, Vec3 def) {
+  return f.size() >= 3 ? Vec3(float(f[0]), float(f[1]), float(f[2])) : def;
+}
 
 }  // namespace
 
@@ -50,31 +49,28 @@ int MaterialMaker::material(int index, bool vertex_color, const std::string& pat
   return slot;
 }
 
-int MaterialMaker::texcoord_set(int index) {
-  if (index < 0) return 0;
-  return m_model.materials[size_t(index)].pbrMetallicRoughness.baseColorTexture.texCoord;
-}
-
-const TextureDesc* MaterialMaker::image_of(const tinygltf::TextureInfo& info, const std::string& path) {
-  const tinygltf::Texture& t = m_model.textures[size_t(info.index)];
+const TextureDesc* MaterialMaker::image_of(int texture, const std::string& path) {
+  const tinygltf::Texture& t = m_model.textures[size_t(texture)];
   if (t.source < 0) {
-    m_ctx.warn("texture without source", path, "texture " + std::to_string(info.index) +
+    m_ctx.warn("texture without source", path, "texture " + std::to_string(texture) +
                                                    " has no source image (only an extension's): it is ignored");
     return nullptr;
   }
   if (!m_images.ok[size_t(t.source)])
-    m_ctx.fail(path, "image " + std::to_string(t.source) + " of texture " + std::to_string(info.index) + " could not be read");
+    m_ctx.fail(path, "image " + std::to_string(t.source) + " of texture " + std::to_string(texture) + " could not be read");
   return &m_images.images[size_t(t.source)];
 }
 
-int MaterialMaker::texture_for(const tinygltf::TextureInfo& info, const std::string& path) {
-  if (m_texture_of.empty()) m_texture_of.assign(m_model.textures.size(), -2);
-  int& slot = m_texture_of[size_t(info.index)];
+int MaterialMaker::texture_for(int texture, bool srgb, const std::string& path) {
+  std::vector<int>& cache = m_texture_of[srgb ? 1 : 0];
+  if (cache.empty()) cache.assign(m_model.textures.size(), -2);
+  int& slot = cache[size_t(texture)];
   if (slot != -2) return slot;
-  const TextureDesc* image = image_of(info, path);
+  const TextureDesc* image = image_of(texture, path);
   if (!image) return slot = -1;
   TextureDesc t = *image;
-  const tinygltf::Texture& gt = m_model.textures[size_t(info.index)];
+  t.srgb = srgb;
+  const tinygltf::Texture& gt = m_model.textures[size_t(texture)];
   if (gt.sampler >= 0) {
     const tinygltf::Sampler& s = m_model.samplers[size_t(gt.sampler)];
     auto wrap = [](int w) {
@@ -95,6 +91,42 @@ int MaterialMaker::texture_for(const tinygltf::TextureInfo& info, const std::str
   return slot;
 }
 
+TextureRef MaterialMaker::texture_ref(int texture, int tex_coord, const tinygltf::ExtensionMap& ext, bool srgb,
+                                      const std::string& path) {
+  TextureRef r;
+  if (texture < 0) return r;
+  r.texture = texture_for(texture, srgb, path);
+  if (r.texture < 0) return r;
+  r.set = tex_coord;
+  // KHR_texture_transform: uv' = T R S uv, R rotating counter-clockwise (the extension's GLSL).
+  if (const tinygltf::Value* t = extension(ext, "KHR_texture_transform")) {
+    const std::string at = path + "/extensions/KHR_texture_transform";
+    double off[2] = {0, 0}, scale[2] = {1, 1};
+    for (int i = 0; i < 2; ++i) {
+      if (t->Has("offset") && t->Get("offset").ArrayLen() == 2) off[i] = t->Get("offset").Get(i).GetNumberAsDouble();
+      if (t->Has("scale") && t->Get("scale").ArrayLen() == 2) scale[i] = t->Get("scale").Get(i).GetNumberAsDouble();
+    }
+    const double rot = number(t, "rotation", 0), c = std::cos(rot), s = std::sin(rot);
+    const double m[6] = {c * scale[0], -s * scale[1], off[0], s * scale[0], c * scale[1], off[1]};
+    for (int i = 0; i < 6; ++i) {
+      if (!std::isfinite(m[i])) m_ctx.fail(at, "is not finite (offset, rotation or scale)");
+      r.m[i] = float(m[i]);
+    }
+    r.transformed = true;
+    if (t->Has("texCoord")) r.set = int(number(t, "texCoord", tex_coord));
+  }
+  if (r.set > 1) {
+    m_ctx.warn("texCoord " + std::to_string(r.set), path + "/texCoord",
+               "TEXCOORD_" + std::to_string(r.set) + " is not read (sets 0 and 1 are): TEXCOORD_0 is used");
+    r.set = 0;
+  }
+  return r;
+}
+
+TextureRef MaterialMaker::texture_ref(const tinygltf::TextureInfo& info, bool srgb, const std::string& path) {
+  return texture_ref(info.index, info.texCoord, info.extensions, srgb, path);
+}
+
 Material MaterialMaker::make(int index, bool vertex_color, const std::string& path) {
   static const tinygltf::Material kDefault;  // glTF's default material: white, metallic 1, roughness 1
   const tinygltf::Material& g = index >= 0 ? m_model.materials[size_t(index)] : kDefault;
@@ -103,100 +135,62 @@ Material MaterialMaker::make(int index, bool vertex_color, const std::string& pa
   const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
   Material m;
   m.name = !g.name.empty() ? g.name : index >= 0 ? "material " + std::to_string(index) : "default";
-
-  Vec3 base(1.0f);
-  if (pbr.baseColorFactor.size() >= 3) base = Vec3(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]));
-  float metallic = float(pbr.metallicFactor), roughness = float(pbr.roughnessFactor);
-  if (pbr.metallicRoughnessTexture.index >= 0) {
-    // Linear data: roughness in G, metalness in B (glTF 2.0, 3.9.2); their means scale the factors.
-    if (const TextureDesc* t = image_of(pbr.metallicRoughnessTexture, pbr_at + "/metallicRoughnessTexture")) {
-      double sum_g = 0, sum_b = 0;
-      const size_t n = size_t(t->width) * size_t(t->height);
-      for (size_t i = 0; i < n; ++i) sum_g += t->texels[3 * i + 1], sum_b += t->texels[3 * i + 2];
-      roughness *= float(sum_g / (255.0 * double(n)));
-      metallic *= float(sum_b / (255.0 * double(n)));
-      m_ctx.warn("metallicRoughnessTexture", pbr_at + "/metallicRoughnessTexture",
-                 "metal / roughness textures are not read per hit: their mean over the image scales the factors");
-    }
+  m.type = MaterialType::pbr;
+  PbrParams& p = m.pbr;
+  p.base = factor3(pbr.baseColorFactor, Vec3(1.0f));
+  p.metallic = float(pbr.metallicFactor);
+  p.roughness = float(pbr.roughnessFactor);
+  p.vertex_color = vertex_color;
+  p.double_sided = g.doubleSided;
+  p.base_tex = texture_ref(pbr.baseColorTexture, true, pbr_at + "/baseColorTexture");
+  p.metal_rough_tex = texture_ref(pbr.metallicRoughnessTexture, false, pbr_at + "/metallicRoughnessTexture");
+  if (g.normalTexture.index >= 0) {
+    p.normal_tex = texture_ref(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions, false,
+                               at + "/normalTexture");
+    p.normal_scale = float(g.normalTexture.scale);
   }
   if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty())
-    m_ctx.warn("alphaMode", at + "/alphaMode", "alphaMode " + clip(g.alphaMode) + " is not supported: surfaces render opaque");
-  if (g.normalTexture.index >= 0) m_ctx.warn("normalTexture", at + "/normalTexture", "normal maps are ignored");
-  auto transmission_ext = g.extensions.find("KHR_materials_transmission");
-  if (transmission_ext != g.extensions.end() && transmission_ext->second.Has("transmissionTexture"))
-    m_ctx.warn("transmissionTexture", at + "/extensions/KHR_materials_transmission/transmissionTexture",
-               "transmission textures are ignored: the factor decides");
-  if (g.occlusionTexture.index >= 0)
-    m_ctx.warn("occlusionTexture", at + "/occlusionTexture", "occlusion textures are ignored (the path tracer finds occlusion)");
+    m_ctx.warn("alphaMode", at + "/alphaMode", "alphaMode " + clip(g.alphaMode) + " is not supported yet: surfaces render opaque");
 
-  // Emission: emissiveFactor x KHR_materials_emissive_strength (x the emissive texture's mean), in
-  // our radiance units; our emitters reflect nothing (docs/gltf.md).
-  Vec3 emissive(0.0f);
-  if (g.emissiveFactor.size() == 3) emissive = Vec3(float(g.emissiveFactor[0]), float(g.emissiveFactor[1]), float(g.emissiveFactor[2]));
-  emissive = emissive * float(extension_number(g.extensions, "KHR_materials_emissive_strength", "emissiveStrength", 1.0));
-  if (g.emissiveTexture.index >= 0 && !is_black(emissive))
-    if (const TextureDesc* t = image_of(g.emissiveTexture, at + "/emissiveTexture")) {
-      emissive = emissive * texture_mean(*t);
-      m_ctx.warn("emissiveTexture", at + "/emissiveTexture", "emissive textures are not read per hit: their mean colour is used");
+  // Emission: emissiveFactor x KHR_materials_emissive_strength (x the emissive texture per hit),
+  // in our radiance units (docs/gltf.md).
+  p.emissive = factor3(g.emissiveFactor, Vec3(0.0f)) *
+               float(number(extension(g.extensions, "KHR_materials_emissive_strength"), "emissiveStrength", 1.0));
+  if (!is_black(p.emissive))
+    p.emissive_tex = texture_ref(g.emissiveTexture, true, at + "/emissiveTexture");
+
+  const std::string ext_at = at + "/extensions/";
+  const double ior = number(extension(g.extensions, "KHR_materials_ior"), "ior", 1.5);
+  p.ior = float(ior >= 1 ? ior : 1.5);  // 0 (a perfect reflector) is read as glTF's default
+  if (const tinygltf::Value* t = extension(g.extensions, "KHR_materials_transmission")) {
+    p.transmission = float(number(t, "transmissionFactor", 0));
+    if (t->Has("transmissionTexture") && p.transmission > 0) {
+      const tinygltf::Value& info = t->Get("transmissionTexture");
+      p.transmission_tex = texture_ref(int(number(&info, "index", -1)), int(number(&info, "texCoord", 0)),
+                                       tinygltf::ExtensionMap(), false, ext_at + "KHR_materials_transmission/transmissionTexture");
     }
-  if (!is_black(emissive)) {
-    m.type = MaterialType::emission;
-    m.radiance = emissive;
-    return m;
   }
-
-  // What a material that is not diffuse takes of a base colour texture: its mean colour.
-  const bool textured = pbr.baseColorTexture.index >= 0;
-  auto base_mean = [&](const char* what) {
-    if (!textured) return base;
-    const TextureDesc* t = image_of(pbr.baseColorTexture, pbr_at + "/baseColorTexture");
-    if (!t) return base;
-    m_ctx.warn(std::string("mean texture ") + what, pbr_at + "/baseColorTexture",
-               std::string("base colour textures of ") + what + " materials are not read per hit: their mean colour is used");
-    return base * texture_mean(*t);
-  };
-  if (vertex_color && (metallic >= 0.5f || extension_number(g.extensions, "KHR_materials_transmission", "transmissionFactor", 0) >= 0.5))
-    m_ctx.warn("vertex colours", path, "vertex colours (COLOR_0) colour diffuse materials only: ignored here");
-
-  // Transmission onto glass: Fresnel reflection and refraction at the KHR_materials_ior index, the
-  // base colour tinting what passes (KHR_materials_transmission); smooth whatever the roughness.
-  const double transmission = extension_number(g.extensions, "KHR_materials_transmission", "transmissionFactor", 0);
-  if (transmission >= 0.5) {
-    double ior = extension_number(g.extensions, "KHR_materials_ior", "ior", 1.5);
+  if (const tinygltf::Value* s = extension(g.extensions, "KHR_materials_specular")) {
+    p.specular = float(number(s, "specularFactor", 1));
+    p.specular_color = color3(s, "specularColorFactor", Vec3(1.0f));
+    if (s->Has("specularTexture") || s->Has("specularColorTexture"))
+      m_ctx.warn("specular textures", ext_at + "KHR_materials_specular",
+                 "specular textures are not read yet: the factors apply");
+  }
+  // Smooth untextured glass and metal are the exact delta BSDFs: the same light as the rough lobes
+  // in the limit, and the light tracer renders their caustics.
+  const bool smooth_plain = ggx::alpha_of(p.roughness) <= ggx::kMinAlpha && !p.textured() && is_black(p.emissive);
+  const Vec3 base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
+  if (smooth_plain && p.transmission >= 1 && p.metallic <= 0 && p.specular == 1 && p.specular_color == Vec3(1.0f)) {
     m.type = MaterialType::glass;
     m.albedo = Vec3(1.0f);
-    m.transmittance = base_mean("glass");
-    m.ior = float(ior >= 1 ? ior : 1.5);
-    if (roughness > 0.05f)
-      m_ctx.warn("rough glass", at, "rough transmission is rendered smooth (our glass has no roughness)");
-    return m;
+    m.transmittance = base;
+    m.ior = p.ior;
+  } else if (smooth_plain && p.metallic >= 1) {
+    m.type = MaterialType::mirror;
+    m.albedo = base;
+    m.schlick = true;
   }
-  if (transmission > 0)
-    m_ctx.warn("partial transmission", at, "transmissionFactor below 0.5 is rendered opaque");
-
-  // Metals: the conductor whose reflectance head on is F0 = lerp(0.04, base, metallic) (the glTF
-  // BRDF's, appendix B.3.5), Beckmann alpha = roughness^2; a smooth one is our mirror.
-  if (metallic >= 0.5f) {
-    const Vec3 f0 = lerp(Vec3(0.04f), base_mean("metallic"), metallic);
-    const float alpha = roughness * roughness;
-    if (alpha < 1e-3f) {
-      m.type = MaterialType::mirror;
-      m.albedo = f0;
-    } else {
-      m.type = MaterialType::microfacet;
-      m.alpha = alpha;
-      conductor_from_reflectance(f0, m.eta, m.k);
-    }
-    if (metallic < 1) m_ctx.warn("partly metallic", pbr_at + "/metallicFactor", "metallic between 0.5 and 1 is rendered as a metal");
-    return m;
-  }
-  // Dielectrics: the diffuse lobe with the glTF BRDF's weight (1 - metallic) base; its specular
-  // layer is not rendered.
-  if (metallic > 0) m_ctx.warn("partly dielectric", pbr_at + "/metallicFactor", "metallic below 0.5 is rendered as a diffuse surface");
-  m.type = MaterialType::diffuse;
-  m.albedo = base * (1 - metallic);
-  if (textured) m.texture = texture_for(pbr.baseColorTexture, pbr_at + "/baseColorTexture");
-  m.vertex_color = vertex_color;
   return m;
 }
 

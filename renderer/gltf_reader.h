@@ -70,7 +70,7 @@ struct Parts {
 
 // What the checks found that the later stages need.
 struct Checked {
-  std::vector<bool> decode_image;  // images a material reads (base colour, metal/roughness, emission)
+  std::vector<bool> decode_image;  // images a material reads (every texture but occlusion's)
 };
 
 // Splits a .glb into its JSON and BIN chunks (glTF 2.0, section 4.4), or takes the text as JSON.
@@ -98,27 +98,27 @@ SceneDesc build_scene(const Context& ctx, const tinygltf::Model& model, Images& 
 
 // Materials (gltf_materials.cpp): our material for glTF material `index` (-1: the default
 // material), with per-hit vertex colours where the primitive has COLOR_0; textures it reads per
-// hit are added to desc.textures.
+// hit are added to desc.textures (the material's TextureRefs say which TEXCOORD sets it reads).
 class MaterialMaker {
  public:
   MaterialMaker(const Context& ctx, const tinygltf::Model& model, Images& images, SceneDesc& desc)
       : m_ctx(ctx), m_model(model), m_images(images), m_desc(desc) {}
   // Index into desc.materials; `path` is where the primitive names the material.
   int material(int index, bool vertex_color, const std::string& path);
-  // The TEXCOORD set the material's base colour texture reads, or -1 when it reads none per hit.
-  int texcoord_set(int index);
 
  private:
   Material make(int index, bool vertex_color, const std::string& path);
-  int texture_for(const tinygltf::TextureInfo& info, const std::string& path);
-  const TextureDesc* image_of(const tinygltf::TextureInfo& info, const std::string& path);
+  TextureRef texture_ref(const tinygltf::TextureInfo& info, bool srgb, const std::string& path);
+  TextureRef texture_ref(int texture, int tex_coord, const tinygltf::ExtensionMap& ext, bool srgb, const std::string& path);
+  int texture_for(int texture, bool srgb, const std::string& path);
+  const TextureDesc* image_of(int texture, const std::string& path);
 
   const Context& m_ctx;
   const tinygltf::Model& m_model;
   Images& m_images;
   SceneDesc& m_desc;
-  std::vector<int> m_made[2];  // by glTF index + 1, with and without vertex colours
-  std::vector<int> m_texture_of;  // desc texture by glTF texture index, or -1
+  std::vector<int> m_made[2];        // by glTF index + 1, with and without vertex colours
+  std::vector<int> m_texture_of[2];  // desc texture by glTF texture index (data, colour), or -1
 };
 
 }  // namespace pt::gltf_detail

@@ -22,6 +22,28 @@ bool finite(const Mat4& m) {
   return true;
 }
 
+// One component of an attribute as a float: normalized integers mapped to [0, 1] or [-1, 1]
+// (glTF 2.0, 3.11; KHR_mesh_quantization).
+float component(int type, bool norm, const uint8_t* q) {
+  switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, q, 4); return v; }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t x; std::memcpy(&x, q, 1); return norm ? std::max(x / 127.0f, -1.0f) : x; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return norm ? *q / 255.0f : *q;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t x; std::memcpy(&x, q, 2); return norm ? std::max(x / 32767.0f, -1.0f) : x; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t x; std::memcpy(&x, q, 2); return norm ? x / 65535.0f : x; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t x; std::memcpy(&x, q, 4); return float(x); }
+  }
+  return 0;
+}
+
+uint32_t index_value(int csize, const uint8_t* p) {
+  if (csize == 1) return *p;
+  if (csize == 2) { uint16_t x; std::memcpy(&x, p, 2); return x; }
+  uint32_t x;
+  std::memcpy(&x, p, 4);
+  return x;
+}
+
 class Builder {
  public:
   Builder(const Context& ctx, const tinygltf::Model& model, Images& images)
@@ -35,6 +57,9 @@ class Builder {
   void visit(int index, const Mat4& parent, int depth);
   void add_primitive(const tinygltf::Primitive& prim, const Mat4& world, const std::string& path, const std::string& name);
   void add_camera(const tinygltf::Node& node, const Mat4& world, const std::string& path);
+  // A normal-mapped mesh's tangents: the file's TANGENT (world space), else generated from the
+  // normal map's uv set (compute_tangents); none without texture coordinates.
+  void add_tangents(MeshDesc& mesh, int tangent_accessor, bool has_uvs, int set, const Mat4& world, const std::string& apath);
   void add_light(int index, const Mat4& world, const std::string& path);
   // Accessor `index` (at `path`, which names it) as `n` floats an element, normalized integers
   // mapped to [0, 1] or [-1, 1] (glTF 2.0, 3.11; KHR_mesh_quantization); `ncomp` lists the
@@ -42,6 +67,11 @@ class Builder {
   std::vector<float> read_floats(int index, const std::string& path, std::initializer_list<int> ncomp, int& got) const;
   std::vector<uint32_t> read_indices(int index, const std::string& path) const;
   const uint8_t* element_data(const tinygltf::Accessor& a, const std::string& path, size_t elem, size_t& stride) const;
+  // A sparse accessor's substitutions (glTF 2.0, 3.6.2.3): calls put(element, bytes of its value)
+  // for each, after checking that the indices increase strictly and stay below the count.
+  template <class Put>
+  void for_each_sparse(const tinygltf::Accessor& a, const std::string& path, size_t elem, Put&& put) const;
+  const uint8_t* view_bytes(int view, size_t offset, size_t bytes, const std::string& path) const;
   void count_values(size_t n, const std::string& path) const {
     m_values += n;
     if (m_values > m_ctx.limits.max_values)
@@ -84,8 +114,7 @@ Mat4 Builder::local_transform(const tinygltf::Node& node, const std::string& pat
 }
 
 const uint8_t* Builder::element_data(const tinygltf::Accessor& a, const std::string& path, size_t elem, size_t& stride) const {
-  if (a.sparse.isSparse) fail(path, "sparse accessors are not supported");
-  if (a.bufferView < 0) return nullptr;  // all zeros (glTF 2.0, 3.6.2.3)
+  if (a.bufferView < 0) return nullptr;  // all zeros (glTF 2.0, 3.6.2.3), or a sparse accessor's base
   const tinygltf::BufferView& view = m_model.bufferViews[size_t(a.bufferView)];
   const tinygltf::Buffer& buffer = m_model.buffers[size_t(view.buffer)];
   stride = view.byteStride ? view.byteStride : elem;
@@ -94,6 +123,42 @@ const uint8_t* Builder::element_data(const tinygltf::Accessor& a, const std::str
   if (view.byteOffset + view.byteLength > buffer.data.size() || end > view.byteOffset + view.byteLength)
     fail(path, "the accessor's bytes lie outside its buffer");
   return buffer.data.data() + begin;
+}
+
+const uint8_t* Builder::view_bytes(int view_index, size_t offset, size_t bytes, const std::string& path) const {
+  const tinygltf::BufferView& view = m_model.bufferViews[size_t(view_index)];
+  const tinygltf::Buffer& buffer = m_model.buffers[size_t(view.buffer)];
+  if (view.byteOffset + view.byteLength > buffer.data.size() || offset > view.byteLength || bytes > view.byteLength - offset)
+    fail(path, std::to_string(bytes) + " bytes from byte " + std::to_string(offset) + " lie outside bufferView " +
+                   std::to_string(view_index) + " (" + std::to_string(view.byteLength) + " bytes)");
+  return buffer.data.data() + view.byteOffset + offset;
+}
+
+template <class Put>
+void Builder::for_each_sparse(const tinygltf::Accessor& a, const std::string& path, size_t elem, Put&& put) const {
+  if (!a.sparse.isSparse) return;
+  const auto& sp = a.sparse;
+  const std::string at = path + "/sparse";
+  if (sp.count <= 0 || size_t(sp.count) > a.count)
+    fail(at + "/count", std::to_string(sp.count) + " substitutions for " + std::to_string(a.count) + " elements");
+  count_values(size_t(sp.count), at);
+  const int isize = sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 1
+                    : sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
+                                                                                         : 4;
+  const size_t n = size_t(sp.count);
+  const uint8_t* idx = view_bytes(sp.indices.bufferView, size_t(sp.indices.byteOffset), n * size_t(isize), at + "/indices");
+  const uint8_t* val = view_bytes(sp.values.bufferView, size_t(sp.values.byteOffset), n * elem, at + "/values");
+  int64_t last = -1;
+  for (size_t k = 0; k < n; ++k) {
+    const uint32_t i = index_value(isize, idx + k * size_t(isize));
+    if (i >= a.count)
+      fail(at + "/indices", "index " + std::to_string(i) + " (element " + std::to_string(k) + ") is out of range: the accessor has " +
+                                std::to_string(a.count) + " elements");
+    if (int64_t(i) <= last)
+      fail(at + "/indices", "index " + std::to_string(i) + " (element " + std::to_string(k) + ") does not increase strictly");
+    last = i;
+    put(size_t(i), val + k * elem);
+  }
 }
 
 std::vector<float> Builder::read_floats(int index, const std::string& path, std::initializer_list<int> ncomp, int& got) const {
@@ -111,23 +176,17 @@ std::vector<float> Builder::read_floats(int index, const std::string& path, std:
   std::vector<float> out(a.count * size_t(n), 0.0f);
   size_t stride = 0;
   const uint8_t* p = element_data(a, at, size_t(n * csize), stride);
-  if (!p) return out;
   const bool norm = a.normalized;
-  for (size_t i = 0; i < a.count; ++i, p += stride) {
+  auto decode = [&](size_t i, const uint8_t* q) {
     for (int c = 0; c < n; ++c) {
-      const uint8_t* q = p + c * csize;
-      float v = 0;
-      switch (a.componentType) {
-        case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&v, q, 4); break;
-        case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t x; std::memcpy(&x, q, 1); v = norm ? std::max(x / 127.0f, -1.0f) : x; break; }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = norm ? *q / 255.0f : *q; break;
-        case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t x; std::memcpy(&x, q, 2); v = norm ? std::max(x / 32767.0f, -1.0f) : x; break; }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t x; std::memcpy(&x, q, 2); v = norm ? x / 65535.0f : x; break; }
-      }
+      const float v = component(a.componentType, norm, q + c * csize);
       if (!std::isfinite(v)) fail(at, "element " + std::to_string(i) + " is not finite (NaN or infinity)");
       out[i * size_t(n) + size_t(c)] = v;
     }
-  }
+  };
+  if (p)
+    for (size_t i = 0; i < a.count; ++i, p += stride) decode(i, p);
+  for_each_sparse(a, at, size_t(n * csize), decode);
   return out;
 }
 
@@ -146,12 +205,9 @@ std::vector<uint32_t> Builder::read_indices(int index, const std::string& path) 
   std::vector<uint32_t> out(a.count, 0);
   size_t stride = 0;
   const uint8_t* p = element_data(a, at, size_t(csize), stride);
-  if (!p) return out;
-  for (size_t i = 0; i < a.count; ++i, p += stride) {
-    if (csize == 1) out[i] = *p;
-    else if (csize == 2) { uint16_t x; std::memcpy(&x, p, 2); out[i] = x; }
-    else std::memcpy(&out[i], p, 4);
-  }
+  if (p)
+    for (size_t i = 0; i < a.count; ++i, p += stride) out[i] = index_value(csize, p);
+  for_each_sparse(a, at, size_t(csize), [&](size_t i, const uint8_t* q) { out[i] = index_value(csize, q); });
   return out;
 }
 
@@ -220,27 +276,59 @@ void Builder::add_primitive(const tinygltf::Primitive& prim, const Mat4& world, 
     for (size_t v = 0; v < nv; ++v) mesh.normals[v] = normalize(world.normal(Vec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2])));
   }
   const int mat = m_materials.material(prim.material, attr("COLOR_0") >= 0, path + "/material");
-  const Material& m = m_desc.materials[size_t(mat)];
-  if (m.texture >= 0) {
-    const int set = m_materials.texcoord_set(prim.material);
+  const PbrParams& pm = m_desc.materials[size_t(mat)].pbr;
+  for (int set = 0; set < 2; ++set) {
+    bool read = false;
+    for (const TextureRef* r : {&pm.base_tex, &pm.metal_rough_tex, &pm.emissive_tex, &pm.normal_tex, &pm.transmission_tex})
+      read |= r->used() && r->set == set;
+    if (!read) continue;
     const std::string key = "TEXCOORD_" + std::to_string(set);
-    mesh.uvs.assign(nv, Vec2{});
+    std::vector<Vec2>& uvs = set == 0 ? mesh.uvs : mesh.uvs1;
+    uvs.assign(nv, Vec2{});
     if (attr(key.c_str()) >= 0) {
       std::vector<float> uv = read_floats(attr(key.c_str()), apath + key, {2}, n);
       same_count(key.c_str(), uv.size() / 2);
-      for (size_t v = 0; v < nv; ++v) mesh.uvs[v] = Vec2{uv[2 * v], uv[2 * v + 1]};
+      for (size_t v = 0; v < nv; ++v) uvs[v] = Vec2{uv[2 * v], uv[2 * v + 1]};
     } else {
-      m_ctx.warn("no " + key, apath + key, "missing: the material's base colour texture is read at uv (0, 0)");
+      m_ctx.warn("no " + key, apath + key, "missing: the material's textures are read at uv (0, 0)" +
+                                               std::string(pm.normal_tex.used() ? ", and its normal map is ignored" : ""));
     }
   }
-  if (m.vertex_color) {
+  if (pm.vertex_color) {
     std::vector<float> c = read_floats(attr("COLOR_0"), apath + "COLOR_0", {3, 4}, n);
     same_count("COLOR_0", c.size() / size_t(n));
     mesh.colors.resize(nv);
     for (size_t v = 0; v < nv; ++v) mesh.colors[v] = Vec3(c[size_t(n) * v], c[size_t(n) * v + 1], c[size_t(n) * v + 2]);
   }
+  if (pm.normal_tex.used()) add_tangents(mesh, attr("TANGENT"), attr(("TEXCOORD_" + std::to_string(pm.normal_tex.set)).c_str()) >= 0,
+                                         pm.normal_tex.set, world, apath);
   mesh.tri_material.assign(tris, mat);
   if (tris) m_desc.meshes.push_back(std::move(mesh));
+}
+
+void Builder::add_tangents(MeshDesc& mesh, int tangent_accessor, bool has_uvs, int set, const Mat4& world,
+                           const std::string& apath) {
+  const size_t nv = mesh.positions.size();
+  if (!has_uvs) return;  // warned: the normal map is ignored
+  if (tangent_accessor >= 0) {
+    int n = 0;
+    std::vector<float> t = read_floats(tangent_accessor, apath + "TANGENT", {4}, n);
+    if (t.size() / 4 != nv) fail(apath + "TANGENT", std::to_string(t.size() / 4) + " elements, POSITION has " + std::to_string(nv));
+    mesh.tangents.resize(nv);
+    size_t zero = 0;
+    for (size_t v = 0; v < nv; ++v) {
+      const Vec3 d = world.vector(Vec3(t[4 * v], t[4 * v + 1], t[4 * v + 2]));
+      if (!(length_squared(d) > 0)) ++zero;
+      // A mirroring transform flips the bitangent's handedness with the winding.
+      const float sign = (t[4 * v + 3] < 0) != (world.det3() < 0) ? -1.0f : 1.0f;
+      mesh.tangents[v] = {d.x, d.y, d.z, sign};
+    }
+    if (zero)
+      m_ctx.warn("zero tangent", apath + "TANGENT", std::to_string(zero) + " tangents of length 0: the normal map is "
+                                                        "not applied there");
+    return;
+  }
+  compute_tangents(mesh, set);
 }
 
 void Builder::add_camera(const tinygltf::Node& node, const Mat4& world, const std::string& path) {
@@ -333,6 +421,7 @@ SceneDesc Builder::run() {
     if (!roots.empty()) m_ctx.warn("no scene", "/scenes", "the file names no scene: every root node is rendered");
   }
   for (int r : roots) visit(r, Mat4::identity(), 0);
+  m_desc.camera.overview = !m_desc.camera.present;
   if (m_desc.meshes.empty() && m_desc.lights.empty()) fail(where, "the scene has no triangles and no lights");
   return std::move(m_desc);
 }

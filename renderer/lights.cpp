@@ -128,6 +128,7 @@ bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s) {
     case LightKind::mesh: {
       Vec3 q, n;
       sample_area_light_point(light, u, q, n);
+      n = facing_normal(light, n, p - q);
       s.radiance = light.color;
       s.point = q;
       return lane1::sample_area_light(p, q, n, light.area, s.wi, s.pdf);

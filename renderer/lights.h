@@ -44,6 +44,7 @@ struct Light {
   float exponent = 0;    // spot fall-off exponent
   float cos_inner = 2;   // spot: cosine of the full-intensity cone's half angle (glTF); > 1: none
   bool sphere = false;   // ambient: every direction, not only the +Y hemisphere (the default light)
+  bool two_sided = false;  // mesh: both faces emit (a double-sided glTF emitter)
   std::vector<Vec3> triangles;  // mesh: three corners per triangle, world space
   std::vector<Vec3> triangle_normals;  // mesh: each triangle's unit normal, kept off the sampling path
   Distribution1D triangle_distribution;
@@ -54,6 +55,10 @@ struct Light {
     return kind == LightKind::directional || kind == LightKind::ambient || kind == LightKind::environment;
   }
 };
+
+// An area light's normal at a sampled point, turned towards `to` (from the point) when both of the
+// light's faces emit.
+inline Vec3 facing_normal(const Light& l, Vec3 n, Vec3 to) { return l.two_sided && dot(to, n) < 0 ? -n : n; }
 
 struct LightSample {
   Vec3 wi;         // unit direction from the shading point towards the light

@@ -2,6 +2,7 @@
 // Frame conventions are in materials.h.
 #include "materials.h"
 
+#include "pbr.h"
 #include "sampling.h"
 
 namespace pt {
@@ -14,6 +15,7 @@ const char* material_type_name(MaterialType type) {
     case MaterialType::refraction: return "refraction";
     case MaterialType::microfacet: return "microfacet";
     case MaterialType::emission: return "emission";
+    case MaterialType::pbr: return "pbr";
   }
   return "?";
 }
@@ -23,10 +25,14 @@ bool is_delta(const Material& m) {
 }
 
 bool is_transmissive(const Material& m) {
-  return m.type == MaterialType::glass || m.type == MaterialType::refraction;
+  return m.type == MaterialType::glass || m.type == MaterialType::refraction ||
+         (m.type == MaterialType::pbr && (m.pbr.transmission > 0 || m.pbr.transmission_tex.used()));
 }
 
-bool is_emissive(const Material& m) { return m.type == MaterialType::emission && !is_black(m.radiance); }
+bool is_emissive(const Material& m) {
+  if (m.type == MaterialType::pbr) return !is_black(m.pbr.emissive);
+  return m.type == MaterialType::emission && !is_black(m.radiance);
+}
 
 float fresnel_dielectric(float cos_i, float eta_i, float eta_t) {
   // Index-matched: no interface. (Otherwise 1 - cos^2 rounds to 1 near grazing and reads as TIR.)
@@ -104,6 +110,8 @@ Vec3 eval_bsdf(const Material& m, Vec3 wo, Vec3 wi) {
       return diffuse_eval(m, wo, wi);
     case MaterialType::microfacet:
       return microfacet_f(m, wo, wi);
+    case MaterialType::pbr:
+      return pbr_eval(m.pbr, wo, wi);
     case MaterialType::mirror:
     case MaterialType::glass:
     case MaterialType::refraction:
@@ -119,6 +127,8 @@ float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi) {
       return diffuse_pdf(wo, wi);
     case MaterialType::microfacet:
       return microfacet_pdf(m, wo, wi);
+    case MaterialType::pbr:
+      return pbr_pdf(m.pbr, wo, wi);
     case MaterialType::mirror:
     case MaterialType::glass:
     case MaterialType::refraction:
@@ -152,6 +162,10 @@ bool sample_bsdf(const Material& m, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s
       s.pdf = 1;
       s.delta = true;
       s.weight = m.albedo;
+      if (m.schlick) {
+        const float c = clampf(1 - std::fabs(wo.z), 0, 1), c2 = c * c;
+        s.weight = m.albedo + (Vec3(1.0f) - m.albedo) * (c2 * c2 * c);
+      }
       return true;
     }
     case MaterialType::glass:
@@ -180,6 +194,8 @@ bool sample_bsdf(const Material& m, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s
       s.weight = m.transmittance * (eta * eta);
       return s.pdf > 0;
     }
+    case MaterialType::pbr:
+      return pbr_sample(m.pbr, wo, u_lobe, u, s);
     case MaterialType::emission:
       return false;
   }
@@ -187,8 +203,11 @@ bool sample_bsdf(const Material& m, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s
 }
 
 Vec3 emitted_radiance(const Material& m, Vec3 wo) {
-  if (m.type != MaterialType::emission || wo.z <= 0) return Vec3(0.0f);
-  return m.radiance;
+  if (m.type == MaterialType::pbr) return wo.z > 0 || (m.pbr.double_sided && wo.z < 0) ? m.pbr.emissive : Vec3(0.0f);
+  if (wo.z <= 0) return Vec3(0.0f);
+  return m.type == MaterialType::emission ? m.radiance : Vec3(0.0f);
 }
+
+bool chooses_lobe(const Material& m) { return is_transmissive(m) || m.type == MaterialType::pbr; }
 
 }  // namespace pt

@@ -58,7 +58,7 @@ const std::vector<RenderOption> kOptions = {
      "caustics through mirror and glass by light tracing (off: by path tracing alone)",
      "pathtracer:caustic_tracing", PT_FIELD(p.caustic_tracing)},
     {"default_light", "--no-default-light", OptionType::boolean, 0, 1, 1, 1,
-     "light a glTF scene without lights or emitters by a uniform white environment",
+     "light a glTF scene without lights or emitters by a white environment and a sun",
      "pathtracer:default_light", PT_FIELD(p.default_light)},
     {"tile_size", "--tile", OptionType::integer, 1, 4096, 32, 32, "tile size in pixels", "pathtracer:tile_size",
      PT_FIELD(p.tile_size)},

@@ -36,7 +36,7 @@ struct RenderParams {
   int tile_size = 32;
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
   bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
-  bool default_light = true;       // --no-default-light: no white environment for an unlit glTF scene
+  bool default_light = true;       // --no-default-light: no default light for an unlit glTF scene
 
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;

@@ -48,7 +48,6 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
   u.resize(size_t(n));
   samplers.resize(size_t(n));
   for (int j = 0; j < n; ++j) samplers[size_t(j)] = &rngs[slots[which[j]].job];
-  const bool textures = scene.features.textured;
   // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
   // for all vertices at once: each sampler still sees its own draws in that order.
   for (size_t l = 0; l < nl; ++l)  // light sample l of every vertex: u_light[l n, (l + 1) n)
@@ -60,7 +59,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
     PathState& st = slots[i].st;
     const SurfaceHit& h = hits[i];
     const Material& m = scene.materials[h.material];
-    const Vec3 albedo = textures && m.textured() ? albedo_at(scene, m, h) : m.albedo;
+    const Vec3 albedo = m.albedo;  // textured materials are glTF's, never diffuse
     v.px[j] = h.p.x, v.py[j] = h.p.y, v.pz[j] = h.p.z;
     v.gx[j] = h.ng.x, v.gy[j] = h.ng.y, v.gz[j] = h.ng.z;
     v.nx[j] = h.ns.x, v.ny[j] = h.ns.y, v.nz[j] = h.ns.z;
@@ -86,6 +85,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
       if (light.kind == LightKind::mesh) {
         Vec3 q, normal;
         sample_area_light_point(light, u, q, normal);
+        normal = facing_normal(light, normal, Vec3(v.px[j], v.py[j], v.pz[j]) - q);
         v.qx[j] = q.x, v.qy[j] = q.y, v.qz[j] = q.z;
         v.lx[j] = normal.x, v.ly[j] = normal.y, v.lz[j] = normal.z;
       }

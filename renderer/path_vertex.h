@@ -61,6 +61,7 @@ struct Vertex {
   Frame frame;
   Vec3 ng;  // geometric normal, flipped to the viewer's side for opaque surfaces
   Vec3 wo;  // local
+  bool transmissive;  // light may arrive from either side
 };
 
 inline int samples_for(const Light& light, const PathSettings& settings) {
@@ -85,7 +86,7 @@ void direct_light_sampling(const RenderScene& scene, const PathSettings& setting
       LightSample ls;
       Vec2 u = rng.next_2d();
       if (!sample_light(light, v.hit.p, u, ls)) continue;
-      if (!lane1::above_surface(ls.wi, v.ng)) continue;
+      if (!v.transmissive && !lane1::above_surface(ls.wi, v.ng)) continue;
       Vec3 wi = v.frame.to_local(ls.wi);
       Vec3 f = eval_f<F>(v.material, v.wo, wi);
       if (is_black(f) || is_black(ls.radiance)) continue;
@@ -214,6 +215,7 @@ bool diffuse_vertex(const RenderScene& scene, const PathSettings& settings, Path
       if (light.kind == LightKind::mesh) {
         Vec3 q, normal;
         sample_area_light_point(light, u, q, normal);
+        normal = facing_normal(light, normal, hit.p - q);
         v.qx[0] = q.x, v.qy[0] = q.y, v.qz[0] = q.z;
         v.lx[0] = normal.x, v.ly[0] = normal.y, v.lz[0] = normal.z;
       }
@@ -266,10 +268,11 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
   }
 
   const Material* file_material = &scene.materials[hit.material];
-  if constexpr ((F & kFeatTexture) != 0) file_material = &material_at(scene, *file_material, hit);  // used within this call
+  Vec3 ns = hit.ns;  // a normal map may bend it
+  if constexpr ((F & kFeatTexture) != 0) file_material = &material_at(scene, *file_material, hit, ns);  // used within this call
   const Material& material = *file_material;
   Vec3 wo_world = -st.ray.d;
-  if (material.type == MaterialType::emission) {
+  if (material.type == MaterialType::emission || (material.type == MaterialType::pbr && is_emissive(material))) {
     Vec3 le = emitted_radiance(material, Vec3(0, 0, dot(wo_world, hit.ng)));
     bool light_traced = false;
     if constexpr ((F & kFeatDelta) != 0)
@@ -285,17 +288,17 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
       }
       st.radiance += st.beta * le * w;
     }
-    return false;  // emitters reflect nothing
+    if (material.type == MaterialType::emission) return false;  // the course's emitters reflect nothing
   }
   if (st.depth_left == 0) return false;
   if (diffuse_lit && material.type == MaterialType::diffuse)
     return diffuse_vertex(scene, settings, st, bounce, hit, material, rng, rays, shadow);
 
   // Shading frame. Opaque surfaces are two-sided: turn the normals towards the viewer.
-  Vec3 ng = hit.ng, ns = hit.ns;
+  Vec3 ng = hit.ng;
   bool transmissive = has_transmission<F>(material);
   face_viewer(wo_world, transmissive, ng, ns);
-  Vertex v{hit, material, Frame(ns), ng, Vec3()};
+  Vertex v{hit, material, Frame(ns), ng, Vec3(), transmissive};
   v.wo = v.frame.to_local(wo_world);
 
   if (!has_delta<F>(material)) {
@@ -306,9 +309,9 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
   }
 
   BsdfSample bs;
-  // Only glass and refraction choose a lobe; other materials skip that draw unevaluated.
+  // Only glass, refraction and the glTF material choose a lobe; others skip that draw unevaluated.
   float u_lobe = 0;
-  if (transmissive) u_lobe = rng.next_float();
+  if (transmissive || material.type == MaterialType::pbr) u_lobe = rng.next_float();
   else rng.skip_1d();
   Vec2 u;  // delta lobes need no direction sample: skipped, the draws after it stay the same
   if (has_delta<F>(material)) rng.skip_2d();

@@ -14,6 +14,23 @@
 
 namespace pt {
 
+namespace {
+
+// What a textured material reads that the mesh lacks, or nullptr.
+const char* unreadable_textures(const PbrParams& p, const MeshDesc& mesh, size_t textures) {
+  const size_t nv = mesh.positions.size();
+  for (const TextureRef* r : {&p.base_tex, &p.metal_rough_tex, &p.emissive_tex, &p.normal_tex, &p.transmission_tex}) {
+    if (!r->used()) continue;
+    if (size_t(r->texture) >= textures) return "its texture";
+    if ((r->set == 0 ? mesh.uvs : mesh.uvs1).size() != nv) return "texture coordinates";
+  }
+  if (p.normal_tex.used() && mesh.tangents.size() != nv) return "tangents";
+  if (p.vertex_color && mesh.colors.size() != nv) return "vertex colours";
+  return nullptr;
+}
+
+}  // namespace
+
 void RenderParams::validate() const {
   auto bad = [](const std::string& field, const std::string& why) { throw std::invalid_argument(field + ": " + why); };
   // Every option's range from the one table (options.h); RunLimits are the driver's to check.
@@ -110,6 +127,8 @@ SceneBase make_scene_base(const SceneDesc& desc) {
     for (size_t t = 0; t < mesh.tri_material.size(); ++t) {
       int mat = mesh.tri_material[t];
       if (!is_emissive(base.materials[mat])) continue;
+      // A textured emitter is no light: hits find its radiance, light sampling could not.
+      if (base.materials[mat].type == MaterialType::pbr && base.materials[mat].pbr.emissive_tex.used()) continue;
       const uint32_t* vi = &mesh.indices[3 * t];
       if (!(length(cross(mesh.positions[vi[1]] - mesh.positions[vi[0]], mesh.positions[vi[2]] - mesh.positions[vi[0]])) > 0))
         continue;  // a zero-area triangle cannot emit
@@ -118,7 +137,8 @@ SceneBase make_scene_base(const SceneDesc& desc) {
         Light l;
         l.kind = LightKind::mesh;
         l.name = mesh.name;
-        l.color = base.materials[mat].radiance;
+        l.color = emitted_radiance(base.materials[mat], Vec3(0, 0, 1));  // what the front sends
+        l.two_sided = base.materials[mat].type == MaterialType::pbr && base.materials[mat].pbr.double_sided;
         it = light_of_material.emplace(mat, int(base.lights.size())).first;
         base.lights.push_back(std::move(l));
       }
@@ -158,37 +178,39 @@ SceneBase make_scene_base(const SceneDesc& desc) {
   f.meshes = !desc.meshes.empty();
   for (const MeshDesc& m : desc.meshes) f.shading_normals |= !m.normals.empty();
   f.bits = 0;
+  bool pbr = false;
   for (const Material& m : base.materials) {
     if (is_delta(m)) f.bits |= kFeatDelta;
     if (m.type == MaterialType::microfacet) f.bits |= kFeatMicrofacet;
+    pbr |= m.type == MaterialType::pbr;
   }
   for (const Light& l : base.lights)
     if (l.kind == LightKind::ambient) f.bits |= kFeatInfinite;
-  // Textured materials: diffuse, on meshes that carry what they read (the loaders guarantee it).
+  // Textured materials, on meshes that carry what they read (the loaders guarantee it).
   for (size_t mi = 0; mi < desc.meshes.size(); ++mi) {
     const MeshDesc& mesh = desc.meshes[mi];
     for (int t : mesh.tri_material) {
       const Material& m = base.materials[size_t(t)];
       if (!m.textured()) continue;
-      if (m.type != MaterialType::diffuse || (m.texture >= 0 && (mesh.uvs.size() != mesh.positions.size() ||
-                                                                  size_t(m.texture) >= desc.textures.size())) ||
-          (m.vertex_color && mesh.colors.size() != mesh.positions.size()))
+      if (const char* why = unreadable_textures(m.pbr, mesh, desc.textures.size()))
         throw std::runtime_error(desc.source + ": material '" + m.name + "' is textured but mesh '" + mesh.name +
-                                 "' cannot give it texture coordinates or colours");
-      f.bits |= kFeatTexture;
-      break;
+                                 "' cannot give it " + why);
+      f.textured = true;
     }
   }
   for (const SphereDesc& s : desc.spheres)
     if (base.materials[size_t(s.material)].textured())
       throw std::runtime_error(desc.source + ": sphere '" + s.name + "' has a textured material");
-  if (f.bits & kFeatTexture) {
+  if (f.textured) {
     base.textures = std::make_shared<const std::vector<TextureDesc>>(desc.textures);
-    f.textured = true;
     f.textures = desc.textures.size();
-    f.bits = kFeatAll;  // textured scenes take the generic loop (path_tracer_for)
   }
-  base.default_light = desc.default_light;
+  if (pbr || f.textured) f.bits = kFeatAll;  // glTF materials take the generic loop (path_tracer_for)
+  // An emitter lights the scene even where it is no light (a textured one): no default light then.
+  bool emitters = false;
+  for (const MeshDesc& mesh : desc.meshes)
+    for (int t : mesh.tri_material) emitters |= is_emissive(base.materials[size_t(t)]);
+  base.default_light = desc.default_light && !emitters;
   base.triangle_count = desc.triangle_count();
   base.sphere_count = desc.spheres.size();
   base.camera = desc.camera;
@@ -259,17 +281,25 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
     f.lights.assign(kinds.begin(), kinds.end());
   }
   if (base.default_light && params.default_light && rs->lights.empty()) {
-    // As glTF viewers light an unlit scene: white from every direction, unseen by camera rays.
-    std::fprintf(stderr, "warning: %s: no lights and no emissive surfaces: lit by a uniform white environment "
+    // As a glTF viewer lights an unlit scene: white from every direction (unseen by camera rays)
+    // and a sun from above, so that shapes shade (render_scene.h, kDefault*).
+    std::fprintf(stderr, "warning: %s: no lights and no emissive surfaces: lit by a white environment and a sun "
                  "(--no-default-light: none)\n", base.source.c_str());
-    Light l;
-    l.kind = LightKind::ambient;
-    l.name = "default environment";
-    l.color = Vec3(1.0f);
-    l.sphere = true;
-    rs->lights.push_back(std::move(l));
+    Light env;
+    env.kind = LightKind::ambient;
+    env.name = "default environment";
+    env.color = Vec3(kDefaultEnvironment);
+    env.sphere = true;
+    rs->lights.push_back(std::move(env));
+    Light sun;
+    sun.kind = LightKind::directional;
+    sun.name = "default sun";
+    sun.color = Vec3(kDefaultSunIrradiance);
+    sun.direction = -kDefaultSunDirection;
+    rs->lights.push_back(std::move(sun));
     std::set<std::string> kinds(f.lights.begin(), f.lights.end());
     kinds.insert("ambient");
+    kinds.insert("directional");
     f.lights.assign(kinds.begin(), kinds.end());
   }
   for (size_t i = 0; i < rs->lights.size(); ++i)
@@ -308,20 +338,13 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
   return view_of(make_scene_base(desc), params);
 }
 
-[[gnu::noinline]] const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
-  thread_local Material scratch;
-  scratch.type = MaterialType::diffuse;
-  scratch.albedo = albedo_at(scene, m, hit);
-  return scratch;
-}
-
 float autofocus_distance(const RenderScene& scene, float sx, float sy) {
   Ray r = scene.camera.pinhole_ray(sx, sy);
   SurfaceHit hit;
   if (!scene.accel->intersect(r, hit)) return kInf;
   // The thin lens focuses on a plane at a depth along the view axis, not at a distance along the
   // ray: an off-centre hit's distance would put the plane behind it by 1 / cos of the ray's angle.
-  const float depth = dot(r.d * hit.t, -scene.camera.back);
+  const float depth = dot(hit.p - r.o, -scene.camera.back);
   return depth > 0 ? depth : kInf;
 }
 

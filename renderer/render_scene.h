@@ -24,7 +24,7 @@ enum FeatureBits : uint32_t {
   kFeatDelta = 1,        // mirror, glass or refraction materials
   kFeatMicrofacet = 2,   // microfacet materials
   kFeatInfinite = 4,     // ambient or environment lights (escaping rays look them up)
-  kFeatTexture = 8,      // textured materials (texture or vertex colours): such scenes take the generic loop
+  kFeatTexture = 8,      // glTF materials (textures, vertex colours, the pbr BSDF): such scenes take the generic loop
   kFeatAll = 15,
 };
 
@@ -33,7 +33,7 @@ struct SceneFeatures {
   bool spheres = false, meshes = false, environment = false, thin_lens = false;
   bool adaptive = false, shading_normals = false;
   bool caustic_tracing = false;  // caustics by light tracing (caustics.h)
-  bool textured = false;         // textured materials (textures or vertex colours)
+  bool textured = false;         // textured glTF materials (textures or vertex colours)
   size_t textures = 0;           // textures the materials read per hit
   uint32_t bits = kFeatAll;  // which specialised path loop runs
 };
@@ -45,7 +45,7 @@ struct SceneBase {
   std::vector<Material> materials;  // the file's, then one emission material per area-light panel
   std::vector<Light> lights;        // without the environment map (that is a render option)
   std::shared_ptr<const std::vector<TextureDesc>> textures;  // what textured materials read
-  bool default_light = false;       // SceneDesc::default_light: a view may add the white environment
+  bool default_light = false;       // SceneDesc::default_light: a view may add the default light
   std::shared_ptr<const Accel> accel;
   SceneFeatures features;           // what the file contains; a view adds the options' features
   size_t triangle_count = 0, sphere_count = 0;
@@ -70,6 +70,12 @@ struct LoopForms {
   bool lanes = true;
 };
 
+// The default light of a glTF scene without lights or emitters (SceneDesc::default_light): a
+// uniform environment of this radiance plus a sun of this irradiance (W/m^2) shining from this
+// direction (towards the sun: above, in front, a little to the side of the default view).
+constexpr float kDefaultEnvironment = 0.5f, kDefaultSunIrradiance = 2.0f;
+inline const Vec3 kDefaultSunDirection = normalize(Vec3(0.25f, 0.85f, 0.45f));
+
 struct RenderScene {
   LoopForms loop;
   std::vector<Material> materials;
@@ -90,23 +96,15 @@ struct RenderScene {
   bool emitters_share_a_plane = false;  // from SceneBase (caustics.h)
 };
 
-// A textured material's albedo at a hit: its albedo times its texture at the hit's uv and the
-// hit's vertex colour (Material::texture, vertex_color).
-inline Vec3 albedo_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
-  Vec3 a = m.albedo;
-  if (m.texture >= 0) a = a * eval_texture((*scene.textures)[size_t(m.texture)], hit.uv);
-  if (m.vertex_color) a = a * Vec3(srgb8_to_linear(hit.color[0]), srgb8_to_linear(hit.color[1]), srgb8_to_linear(hit.color[2]));
-  return a;
-}
-
-// A textured material at a hit: a diffuse material with the albedo there, held per thread until
-// the thread's next call (textured materials are diffuse: make_scene_base checks). Out of line, so
-// that the loops that may meet one stay as small as without textures.
-const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit);
+// A glTF material at a hit (Material::textured): its factors times its textures at the hit's
+// texture coordinates and its vertex colour, and the shading normal `ns` bent by its normal map.
+// Held per thread until the thread's next call. Out of line, so that the loops that may meet one
+// stay as small as without textures.
+const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit, Vec3& ns);
 
 // The material a path sees at a hit: `m`, or textured_material for a textured one.
-inline const Material& material_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit) {
-  return __builtin_expect(m.textured(), 0) ? textured_material(scene, m, hit) : m;
+inline const Material& material_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit, Vec3& ns) {
+  return __builtin_expect(m.textured(), 0) ? textured_material(scene, m, hit, ns) : m;
 }
 
 // Builds what the integrator needs from the file's description: lights (area lights also as

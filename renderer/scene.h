@@ -1,6 +1,7 @@
 // SceneDesc: what a scene file says, as plain validated data (world space, Y up).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -11,34 +12,65 @@
 namespace pt {
 
 // Materials are a closed set; every switch over this enum lives in materials.cpp.
-enum class MaterialType { diffuse, mirror, glass, refraction, microfacet, emission };
+enum class MaterialType { diffuse, mirror, glass, refraction, microfacet, emission, pbr };
 const char* material_type_name(MaterialType type);
+
+// A texture a glTF material reads at a hit: which one, from which TEXCOORD set, through
+// KHR_texture_transform's matrix.
+struct TextureRef {
+  int texture = -1;  // index into SceneDesc::textures; -1: none
+  int set = 0;       // TEXCOORD_0 or TEXCOORD_1
+  bool transformed = false;
+  float m[6] = {1, 0, 0, 0, 1, 0};  // uv' = (m0 u + m1 v + m2, m3 u + m4 v + m5)
+  bool used() const { return texture >= 0; }
+};
+
+// glTF 2.0's metal-rough material with the extensions read (docs/gltf.md): the factors, and the
+// textures that multiply them at each hit (material_at). Plain data: a hit's copy is cheap.
+struct PbrParams {
+  Vec3 base{1, 1, 1};  // base colour (linear), x COLOR_0 where vertex_color
+  float metallic = 1, roughness = 1;
+  float ior = 1.5f;                        // KHR_materials_ior
+  float specular = 1;                      // KHR_materials_specular: F0 and F90 scale
+  Vec3 specular_color{1, 1, 1};            // KHR_materials_specular: F0 tint
+  float transmission = 0;                  // KHR_materials_transmission
+  Vec3 emissive{0, 0, 0};                  // emissiveFactor x KHR_materials_emissive_strength
+  float normal_scale = 1;
+  bool vertex_color = false;               // the mesh's COLOR_0 multiplies the base colour
+  bool double_sided = false;               // doubleSided: emission leaves both faces
+  TextureRef base_tex, metal_rough_tex, emissive_tex, normal_tex, transmission_tex;
+  bool textured() const {
+    return vertex_color || base_tex.used() || metal_rough_tex.used() || emissive_tex.used() || normal_tex.used() ||
+           transmission_tex.used();
+  }
+};
 
 struct Material {
   std::string name;
   MaterialType type = MaterialType::diffuse;
   Vec3 albedo{0.5f, 0.5f, 0.5f};  // diffuse colour, or mirror/glass reflectance
+  bool schlick = false;           // mirror: albedo is F0 of Schlick's Fresnel (glTF's smooth metals)
   Vec3 transmittance{1, 1, 1};    // glass / refraction
   float ior = 1.5f;               // glass / refraction
   float alpha = 0.5f;             // microfacet Beckmann roughness
   Vec3 eta{1, 1, 1}, k{0, 0, 0};  // microfacet conductor, per RGB channel
   Vec3 radiance{0, 0, 0};         // emission
-  // Diffuse only: the albedo is multiplied at each hit by this texture at the hit's uv and, with
-  // vertex_color, by the mesh's interpolated vertex colour (the meshes carry uvs / colors then).
-  int texture = -1;
-  bool vertex_color = false;
-  bool textured() const { return texture >= 0 || vertex_color; }
+  PbrParams pbr;                  // pbr (glTF)
+  // Read per hit (material_at): the pbr material's textures and vertex colours.
+  bool textured() const { return type == MaterialType::pbr && pbr.textured(); }
 };
 
 // How texture coordinates outside [0, 1] wrap (glTF sampler wrapS / wrapT).
 enum class TextureWrap { repeat, clamp, mirror };
 
-// A colour texture as the file stores it: sRGB-encoded 8-bit RGB, the top row first; uv (0, 0) is
-// the top-left corner of the image (glTF 2.0, section 3.8.4.2). Filtered bilinearly, or nearest.
+// A texture as the file stores it: 8-bit RGB, the top row first; uv (0, 0) is the top-left corner
+// of the image (glTF 2.0, section 3.8.4.2). Filtered bilinearly, or nearest. Colours are
+// sRGB-encoded; data (metal / roughness, normals) is linear.
 struct TextureDesc {
   std::string name;
   int width = 0, height = 0;
   std::vector<uint8_t> texels;  // 3 bytes a texel
+  bool srgb = true;
   TextureWrap wrap_s = TextureWrap::repeat, wrap_t = TextureWrap::repeat;
   bool nearest = false;
 };
@@ -76,8 +108,11 @@ struct MeshDesc {
   std::vector<uint32_t> indices;   // three per triangle
   std::vector<int> tri_material;   // one material index per triangle
   std::vector<Vec3> normals;       // per-vertex shading normals; empty means flat shading
-  std::vector<Vec2> uvs;           // per-vertex texture coordinates, or empty
+  std::vector<Vec2> uvs;           // per-vertex texture coordinates (TEXCOORD_0), or empty
+  std::vector<Vec2> uvs1;          // TEXCOORD_1, or empty
   std::vector<Vec3> colors;        // per-vertex linear RGB colours, or empty
+  // Per-vertex tangents for normal maps (xyz, w = the bitangent's sign), world space, or empty.
+  std::vector<std::array<float, 4>> tangents;
 };
 
 struct SphereDesc {
@@ -96,6 +131,9 @@ struct CameraDesc {
   // glTF: placed as authored whatever --file-camera says, keeping the vertical field of view (the
   // course's bounding-box framing is for COLLADA scenes).
   bool as_authored = false;
+  // glTF without a camera: a three-quarter view that fits the bounds (make_camera), not the
+  // course's framing down -Z.
+  bool overview = false;
 };
 
 struct SceneDesc {
@@ -109,8 +147,9 @@ struct SceneDesc {
   std::vector<LightDesc> lights;
   std::vector<TextureDesc> textures;
   CameraDesc camera;
-  // glTF: without lights and emitters the render adds a uniform white environment (as glTF viewers
-  // light such a scene; the course renders it black); RenderParams::default_light turns it off.
+  // glTF: without lights and emitters the render adds a white environment and a sun (as glTF
+  // viewers light such a scene; the course renders it black); RenderParams::default_light turns
+  // it off.
   bool default_light = false;
   // What the loader ignored or defaulted, one line each ("file: where: what"), capped by
   // LoadLimits::max_warnings with a last line counting the rest. The loaders also print them to
@@ -125,5 +164,11 @@ struct SceneDesc {
 // Computes area-weighted vertex normals (the course recomputes them this way); leaves
 // `normals` empty when every vertex normal equals its faces' normal (flat shading suffices).
 void compute_vertex_normals(MeshDesc& mesh);
+
+// Per-vertex tangents from texture coordinate set `set` (0: uvs, 1: uvs1), for normal maps: each
+// vertex's dP/du made orthogonal to its normal, and the handedness glTF's bitangent takes
+// (MikkTSpace's per-vertex result for smooth meshes; vertices shared by faces of unrelated uv
+// directions get their average). A vertex without uv area keeps a zero tangent (no bend).
+void compute_tangents(MeshDesc& mesh, int set);
 
 }  // namespace pt

@@ -1,5 +1,5 @@
 // Texture lookups: wrap modes as OpenGL defines them (glTF 2.0 samplers use its enums), bilinear
-// filtering between texel centres, sRGB decode through a 256-entry table.
+// filtering between texel centres, sRGB decode through a 256-entry table (colour textures only).
 #include "texture.h"
 
 #include <array>
@@ -40,6 +40,7 @@ inline int wrap(int i, int n, TextureWrap mode) {
 
 inline Vec3 texel(const TextureDesc& t, int x, int y) {
   const uint8_t* p = &t.texels[3 * (size_t(wrap(y, t.height, t.wrap_t)) * size_t(t.width) + size_t(wrap(x, t.width, t.wrap_s)))];
+  if (!t.srgb) return Vec3(p[0], p[1], p[2]) * (1 / 255.0f);  // data: linear
   const auto& lut = srgb_table();
   return Vec3(lut[p[0]], lut[p[1]], lut[p[2]]);
 }

@@ -15,7 +15,8 @@ float srgb8_to_linear(uint8_t code);
 // The 8-bit sRGB code of a linear value in [0, 1] (clamped), rounded to nearest.
 uint8_t linear_to_srgb8(float v);
 
-// Linear RGB of the texture at uv, wrapped as its sampler says; bilinear unless `nearest`.
+// Linear RGB of the texture at uv (sRGB decoded for colour textures), wrapped as its sampler
+// says; bilinear unless `nearest`.
 Vec3 eval_texture(const TextureDesc& texture, Vec2 uv);
 
 // The mean linear colour of a texture: what materials without per-hit texturing use of it.

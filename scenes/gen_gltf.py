@@ -4,8 +4,10 @@
     python3 scenes/gen_gltf.py [OUTDIR]        (default: the folder of this script)
 
 * cornell_gltf.glb: scenes/cornell.dae converted to glTF (binary): the same walls, blocks, colours,
-  camera; the CGL area light becomes an emissive quad (KHR_materials_emissive_strength), the CGL
-  spheres become smooth-shaded UV spheres, the mirror a smooth metal, the glass
+  camera; the Lambertian surfaces become metallic 0 with KHR_materials_specular's factor 0 (no
+  dielectric specular layer), the CGL area light an emissive quad (KHR_materials_emissive_strength,
+  one-sided: doubleSided false, black and without specular layer, so it reflects nothing), the CGL
+  spheres smooth-shaded UV spheres, the mirror a smooth metal, the glass
   KHR_materials_transmission with KHR_materials_ior. tests/test_gltf_render.cpp renders it against
   the .dae.
 * showcase.gltf: what the glTF reader supports, in one JSON file with data: URIs: a checkerboard
@@ -82,7 +84,7 @@ class Gltf:
         return len(self.doc["meshes"]) - 1
 
     def material(self, name, base=(1, 1, 1), metallic=0.0, roughness=1.0, emissive=None, transmission=None, ior=None,
-                 texture=None):
+                 texture=None, specular=None):
         pbr = {"baseColorFactor": [*base, 1.0], "metallicFactor": metallic, "roughnessFactor": roughness}
         if texture is not None:
             pbr["baseColorTexture"] = {"index": texture}
@@ -97,6 +99,8 @@ class Gltf:
             ext["KHR_materials_transmission"] = {"transmissionFactor": transmission}
         if ior is not None:
             ext["KHR_materials_ior"] = {"ior": ior}
+        if specular is not None:  # 0: no dielectric specular layer, a Lambertian surface
+            ext["KHR_materials_specular"] = {"specularFactor": specular}
         if ext:
             m["extensions"] = ext
             self.extensions.update(ext)
@@ -245,8 +249,8 @@ def write_cornell(out):
                 materials[name] = g.material(name, kind[1], metallic=1.0, roughness=0.0)
             elif kind[0] == "glass":
                 materials[name] = g.material(name, kind[1], transmission=1.0, ior=kind[2], roughness=0.0)
-            else:
-                materials[name] = g.material(name, kind[1])
+            else:  # the course's Lambertian surfaces: glTF's dielectric without its specular layer
+                materials[name] = g.material(name, kind[1], specular=0.0)
         return materials[name]
 
     for name, corners, look in scene["meshes"]:  # triangles that share no vertices: flat shading
@@ -260,7 +264,7 @@ def write_cornell(out):
     e1, e2 = [quad[1][i] - quad[0][i] for i in range(3)], [quad[2][i] - quad[0][i] for i in range(3)]
     normal = (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
     idx = [0, 1, 2, 0, 2, 3] if sum(normal[i] * light["facing"][i] for i in range(3)) > 0 else [0, 2, 1, 0, 3, 2]
-    emitter = g.material("ceiling_light", (0, 0, 0), emissive=light["radiance"])
+    emitter = g.material("ceiling_light", (0, 0, 0), emissive=light["radiance"], specular=0.0)  # reflects nothing
     g.node("ceiling_light", mesh=g.mesh("ceiling_light", quad, idx, emitter))
     cam = scene["camera"]
     yfov = 2 * math.atan(math.tan(math.radians(cam["xfov"]) / 2) / cam["aspect"])

@@ -1,11 +1,13 @@
 // What the scene fuzz targets (fuzz_collada, fuzz_gltf) share: load limits small enough that each
 // input stays fast, and the steps after a successful load (the render scene with tiny render
-// parameters and one autofocus ray; never a render).
+// parameters, one autofocus ray and the central ray's hit shaded; never a render).
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 
+#include "materials.h"
 #include "scene_file.h"
 #include "session.h"
 
@@ -45,6 +47,21 @@ inline int build_and_probe(const pt::SceneDesc& desc, size_t variant) {
     return 0;  // a build failure (Embree) is reported, not a crash
   }
   pt::autofocus_distance(*scene, 0.5f, 0.5f);
+  // The central camera ray's hit shaded as a path would: textures, normal map, the BSDF.
+  const pt::Ray r = scene->camera.pinhole_ray(0.5f, 0.5f);
+  pt::SurfaceHit hit;
+  if (scene->accel->intersect(r, hit)) {
+    pt::Vec3 ns = hit.ns;
+    const pt::Material& m = pt::material_at(*scene, scene->materials[size_t(hit.material)], hit, ns);
+    const pt::Frame frame(ns);
+    const pt::Vec3 wo = frame.to_local(-r.d);
+    pt::BsdfSample s;
+    if (pt::sample_bsdf(m, wo, 0.3f, pt::Vec2{0.4f, 0.6f}, s)) {
+      const pt::Vec3 f = pt::eval_bsdf(m, wo, s.wi);
+      if (!pt::is_finite(f) || !std::isfinite(pt::bsdf_pdf(m, wo, s.wi)) || !pt::is_finite(s.weight))
+        throw std::logic_error("a non-finite BSDF value");
+    }
+  }
   return 0;
 }
 

@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "gltf.h"
+#include "render_scene.h"
 
 namespace pt::test {
 
@@ -113,6 +115,10 @@ struct GltfDoc {
     return out;
   }
 };
+
+// What a white Lambertian quad facing +z reflects under the default light (an unlit glTF scene's):
+// the environment's radiance plus the sun's irradiance x cos / pi.
+inline const double kDefaultLightOnTheQuad = kDefaultEnvironment + kDefaultSunIrradiance * kDefaultSunDirection.z / M_PI;
 
 // A 2 x 2 quad in the z = 0 plane facing +z (uv (0, 0) at its top left), material 0: a white
 // diffuse surface; `extra` attributes may be added by the caller through doc.

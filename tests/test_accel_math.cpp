@@ -155,8 +155,8 @@ TEST(AccelMath, FourSphereTestsAtOnceGiveTheScalarTestsBits) {
 namespace {
 
 bool same_record(const SurfaceHit& a, const SurfaceHit& b) {
-  const float fa[] = {a.t, a.p.x, a.p.y, a.p.z, a.ng.x, a.ng.y, a.ng.z, a.ns.x, a.ns.y, a.ns.z, a.offset};
-  const float fb[] = {b.t, b.p.x, b.p.y, b.p.z, b.ng.x, b.ng.y, b.ng.z, b.ns.x, b.ns.y, b.ns.z, b.offset};
+  const float fa[] = {a.p.x, a.p.y, a.p.z, a.ng.x, a.ng.y, a.ng.z, a.ns.x, a.ns.y, a.ns.z, a.offset};
+  const float fb[] = {b.p.x, b.p.y, b.p.z, b.ng.x, b.ng.y, b.ng.z, b.ns.x, b.ns.y, b.ns.z, b.offset};
   for (size_t k = 0; k < sizeof fa / sizeof fa[0]; ++k)
     if (!same_bits(fa[k], fb[k])) return false;
   return a.material == b.material && a.light == b.light;
@@ -189,7 +189,7 @@ TEST(AccelMath, TriangleRefinementGivesTheScalarRecordsBits) {
   }
   int degenerate = 0, cancelled = 0;
   for (const float* shading : {static_cast<const float*>(nullptr), static_cast<const float*>(normals.data())}) {
-    const TriangleData mesh{positions.data(), indices.data(), shading, tris.data()};
+    const TriangleData mesh{positions.data(), indices.data(), shading, tris.data(), 0, false};
     for (int k = 0; k < 20000; ++k) {
       const unsigned prim = rng() % tris.size();
       float bu = u01(rng), bv = u01(rng);
@@ -198,7 +198,6 @@ TEST(AccelMath, TriangleRefinementGivesTheScalarRecordsBits) {
       const float t = 10 * u01(rng);
       const Vec3 eng = k % 5 == 0 ? Vec3(0.0f) : Vec3(u(rng), u(rng), u(rng));  // a zero one: the fallback's fallback
       SurfaceHit fast, slow;
-      fast.t = slow.t = -1;
       refine_triangle(mesh, prim, t, bu, bv, [&] { return eng; }, fast);
       refine_triangle_scalar(mesh, prim, t, bu, bv, [&] { return eng; }, slow);
       ASSERT_TRUE(same_record(fast, slow)) << "triangle " << prim << " at (" << bu << ", " << bv << ")";

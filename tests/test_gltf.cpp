@@ -39,14 +39,15 @@ TEST(Gltf, OurCornellHasTheColladaScenesContents) {
   EXPECT_TRUE(d.spheres.empty());
   EXPECT_TRUE(d.lights.empty());  // the area light is an emissive mesh
   ASSERT_NE(find_material(d, "ceiling_light"), nullptr);
-  EXPECT_EQ(find_material(d, "ceiling_light")->type, MaterialType::emission);
-  EXPECT_NEAR(find_material(d, "ceiling_light")->radiance.y, 11.0f, 1e-4f);
+  EXPECT_EQ(find_material(d, "ceiling_light")->type, MaterialType::pbr);
+  EXPECT_NEAR(find_material(d, "ceiling_light")->pbr.emissive.y, 11.0f, 1e-4f);
   ASSERT_NE(find_material(d, "glass"), nullptr);
   EXPECT_EQ(find_material(d, "glass")->type, MaterialType::glass);
   EXPECT_FLOAT_EQ(find_material(d, "glass")->ior, 1.5f);
-  EXPECT_EQ(find_material(d, "mirror")->type, MaterialType::mirror);
+  EXPECT_EQ(find_material(d, "mirror")->type, MaterialType::mirror);  // smooth metal: exact, with Schlick's Fresnel
   EXPECT_NEAR(find_material(d, "mirror")->albedo.x, 0.95f, 1e-6f);
-  EXPECT_NEAR(find_material(d, "red")->albedo.x, 0.63f, 1e-6f);
+  EXPECT_TRUE(find_material(d, "mirror")->schlick);
+  EXPECT_NEAR(find_material(d, "red")->pbr.base.x, 0.63f, 1e-6f);
   EXPECT_TRUE(d.camera.present && d.camera.as_authored);
   EXPECT_NEAR(d.camera.world.point(Vec3(0, 0, 0)).z, 4.8f, 1e-5f);
   Bounds3 a = d.geometry_bounds(), b = c.geometry_bounds();
@@ -62,20 +63,17 @@ TEST(Gltf, OurShowcaseMapsEachMaterialLightAndTheCamera) {
   EXPECT_EQ(d.textures[0].wrap_t, TextureWrap::mirror);
   const Material* floor = find_material(d, "checker floor");
   ASSERT_NE(floor, nullptr);
-  EXPECT_EQ(floor->type, MaterialType::diffuse);
-  EXPECT_EQ(floor->texture, 0);
-  EXPECT_TRUE(find_material(d, "vertex-coloured wall")->vertex_color);
+  EXPECT_EQ(floor->type, MaterialType::pbr);
+  EXPECT_EQ(floor->pbr.base_tex.texture, 0);
+  EXPECT_TRUE(d.textures[0].srgb);
+  EXPECT_TRUE(find_material(d, "vertex-coloured wall")->pbr.vertex_color);
   const Material* gold = find_material(d, "rough gold");
-  EXPECT_EQ(gold->type, MaterialType::microfacet);
-  EXPECT_NEAR(gold->alpha, 0.35f * 0.35f, 1e-6f);
-  // The conductor reflects its base colour head on (Gulbrandsen's fit, edge tint = colour).
-  Vec3 f0 = fresnel_conductor(1.0f, gold->eta, gold->k);
-  EXPECT_NEAR(f0.x, 1.0f * 0.999f, 2e-3f);
-  EXPECT_NEAR(f0.y, 0.766f, 1e-4f);
-  EXPECT_NEAR(f0.z, 0.336f, 1e-4f);
+  EXPECT_EQ(gold->type, MaterialType::pbr);
+  EXPECT_NEAR(gold->pbr.roughness, 0.35f, 1e-6f);
+  EXPECT_NEAR(gold->pbr.base.y, 0.766f, 1e-4f);
   EXPECT_EQ(find_material(d, "glass")->type, MaterialType::glass);
   EXPECT_NEAR(find_material(d, "glass")->transmittance.x, 0.95f, 1e-6f);
-  EXPECT_NEAR(find_material(d, "emissive panel")->radiance.y, 5.4f, 1e-5f);
+  EXPECT_NEAR(find_material(d, "emissive panel")->pbr.emissive.y, 5.4f, 1e-5f);
   for (const MeshDesc& m : d.meshes)  // the panel's front (emitting) face looks down on the scene
     if (m.name == "panel") {
       const uint32_t* i = m.indices.data();
@@ -136,7 +134,7 @@ TEST(Gltf, SpotLightsFallOffBetweenTheCones) {
   EXPECT_NEAR(at_angle(0.3), t * t, 1e-4);
 }
 
-TEST(Gltf, MetallicRoughnessMapsOntoTheNearerBsdf) {
+TEST(Gltf, MetallicRoughnessIsReadAsTheGltfMaterial) {
   GltfDoc g = test::quad_doc();
   auto add = [&](const json& pbr, const json& extra = json::object()) {
     json m = extra;
@@ -144,27 +142,38 @@ TEST(Gltf, MetallicRoughnessMapsOntoTheNearerBsdf) {
     int mat = g.material(m);
     g.mesh(json{{"POSITION", 0}}, 1, mat);
   };
-  add(json{{"baseColorFactor", {0.8, 0.6, 0.4, 1}}, {"metallicFactor", 0.25}});        // 1: diffuse (1 - m) base
-  add(json{{"baseColorFactor", {0.8, 0.6, 0.4, 1}}, {"metallicFactor", 0.75}, {"roughnessFactor", 0.5}});  // 2
-  add(json{{"metallicFactor", 1}, {"roughnessFactor", 0}});                              // 3: mirror
+  add(json{{"baseColorFactor", {0.8, 0.6, 0.4, 1}}, {"metallicFactor", 0.25}});  // 1: blended, not a threshold
+  add(json{{"metallicFactor", 0}, {"roughnessFactor", 0.3}},
+      json{{"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.5}, {"specularColorFactor", {1, 0.5, 0.25}}}},
+                           {"KHR_materials_ior", {{"ior", 1.7}}}}}});  // 2
   add(json{{"metallicFactor", 0}}, json{{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1}}},
-                                                        {"KHR_materials_ior", {{"ior", 1.33}}}}}});  // 4: glass
+                                                        {"KHR_materials_ior", {{"ior", 1.33}}}}}});  // 3: rough glass
+  add(json{{"metallicFactor", 0}, {"roughnessFactor", 0}},
+      json{{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1}}}}}});  // 4: smooth glass
   SceneDesc d = parse(g);
   ASSERT_EQ(d.materials.size(), 5u);
-  EXPECT_EQ(d.materials[1].type, MaterialType::diffuse);
-  EXPECT_NEAR(d.materials[1].albedo.x, 0.8f * 0.75f, 1e-6f);
-  EXPECT_EQ(d.materials[2].type, MaterialType::microfacet);
-  EXPECT_NEAR(d.materials[2].alpha, 0.25f, 1e-6f);
-  Vec3 f0 = fresnel_conductor(1.0f, d.materials[2].eta, d.materials[2].k);
-  EXPECT_NEAR(f0.y, 0.04f * 0.25f + 0.6f * 0.75f, 1e-4f);  // lerp(0.04, base, metallic)
-  EXPECT_EQ(d.materials[3].type, MaterialType::mirror);
-  EXPECT_EQ(d.materials[4].type, MaterialType::glass);
-  EXPECT_FLOAT_EQ(d.materials[4].ior, 1.33f);
-  // No material: glTF's default (white, metallic 1, roughness 1): a rough white conductor.
+  const PbrParams& a = d.materials[1].pbr;
+  EXPECT_EQ(d.materials[1].type, MaterialType::pbr);
+  EXPECT_NEAR(a.base.x, 0.8f, 1e-6f);
+  EXPECT_NEAR(a.metallic, 0.25f, 1e-6f);
+  EXPECT_NEAR(a.roughness, 1.0f, 1e-6f);  // glTF's default
+  const PbrParams& b = d.materials[2].pbr;
+  EXPECT_NEAR(b.specular, 0.5f, 1e-6f);
+  EXPECT_NEAR(b.specular_color.z, 0.25f, 1e-6f);
+  EXPECT_NEAR(b.ior, 1.7f, 1e-6f);
+  EXPECT_EQ(d.materials[3].type, MaterialType::pbr);
+  EXPECT_NEAR(d.materials[3].pbr.transmission, 1.0f, 1e-6f);
+  EXPECT_NEAR(d.materials[3].pbr.ior, 1.33f, 1e-6f);
+  EXPECT_TRUE(is_transmissive(d.materials[3]));
+  EXPECT_EQ(d.materials[4].type, MaterialType::glass);  // exact: the light tracer sees it
+  // No material: glTF's default (white, metallic 1, roughness 1).
   GltfDoc h = test::quad_doc();
   h.doc["meshes"][0]["primitives"][0].erase("material");
   SceneDesc e = parse(h);
-  EXPECT_EQ(e.materials[e.meshes[0].tri_material[0]].type, MaterialType::microfacet);
+  const Material& def = e.materials[e.meshes[0].tri_material[0]];
+  EXPECT_EQ(def.type, MaterialType::pbr);
+  EXPECT_EQ(def.pbr.metallic, 1.0f);
+  EXPECT_EQ(def.pbr.roughness, 1.0f);
 }
 
 TEST(Gltf, CameraKeepsItsVerticalFieldOfViewAtAnyImageAspect) {
@@ -186,14 +195,47 @@ TEST(Gltf, CameraKeepsItsVerticalFieldOfViewAtAnyImageAspect) {
   EXPECT_FALSE(parse(g).camera.present);
 }
 
+// Without a camera: a three-quarter view from above and to the side of the bounds (every face of a
+// box shows), looking at their centre, the whole bounding box inside the image at any -r size:
+// the course's framing and crop are COLLADA's.
+TEST(Gltf, AScenesWithoutACameraGetsAThreeQuarterView) {
+  GltfDoc g = test::quad_doc();
+  g.doc["nodes"][0]["translation"] = {3, 1, -2};
+  g.doc["nodes"][0]["scale"] = {1, 1, 2};  // bounds (2, 0, -2) to (4, 2, -2)
+  SceneDesc d = parse(g);
+  ASSERT_FALSE(d.camera.present);
+  EXPECT_TRUE(d.camera.overview);
+  const Bounds3 b = d.geometry_bounds();
+  for (auto [w, h] : {std::pair{320, 240}, std::pair{64, 48}, std::pair{200, 400}}) {
+    CameraParams cp;
+    cp.width = w, cp.height = h;
+    const Camera c = make_camera(d, cp);
+    const Vec3 from = c.position - b.center();
+    EXPECT_GT(from.x, 0) << w;
+    EXPECT_GT(from.y, 0.3f * length(from)) << w << ": looks down on the scene";
+    EXPECT_GT(from.z, 0) << w;
+    EXPECT_NEAR(dot(normalize(from), c.back), 1.0f, 1e-5f) << w << ": looks at the centre";
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 corner((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
+      const Vec3 v = corner - c.position;
+      const float depth = -dot(v, c.back);
+      ASSERT_GT(depth, 0);
+      EXPECT_LE(std::fabs(dot(v, c.right) / depth), c.tan_half_w) << w << " corner " << k;
+      EXPECT_LE(std::fabs(dot(v, c.up) / depth), c.tan_half_h) << w << " corner " << k;
+    }
+  }
+}
+
 TEST(Gltf, UnlitScenesGetTheDefaultLightUnlessTurnedOff) {
   SceneDesc d = parse(test::quad_doc());
   RenderParams p;
   auto lit = make_render_scene(d, p);
-  ASSERT_EQ(lit->lights.size(), 1u);
+  ASSERT_EQ(lit->lights.size(), 2u);  // a white environment and a sun, so that shapes shade
   EXPECT_EQ(lit->lights[0].kind, LightKind::ambient);
   EXPECT_TRUE(lit->lights[0].sphere);
-  EXPECT_EQ(infinite_light_radiance(lit->lights[0], Vec3(0, -1, 0)).x, 1.0f);  // from below too
+  EXPECT_EQ(infinite_light_radiance(lit->lights[0], Vec3(0, -1, 0)).x, kDefaultEnvironment);  // from below too
+  EXPECT_EQ(lit->lights[1].kind, LightKind::directional);
+  EXPECT_GT(-lit->lights[1].direction.y, 0.5f) << "the sun shines from above";
   EXPECT_NE(lit->features.bits & kFeatInfinite, 0u);
   p.default_light = false;
   EXPECT_TRUE(make_render_scene(d, p)->lights.empty());
@@ -270,11 +312,11 @@ TEST(Gltf, UnsupportedModesAreSkippedWithOneWarning) {
   EXPECT_NE(err.find("t.gltf: /meshes/0/primitives/1/mode: primitive mode 1 (LINES)"), std::string::npos) << err;
   EXPECT_EQ(err.find("primitives/2"), std::string::npos) << "one line per mode: " << err;
   // An unsupported extension that is only used: one warning naming it.
-  g.doc["extensionsUsed"] = {"KHR_texture_transform", "KHR_texture_transform"};
+  g.doc["extensionsUsed"] = {"EXT_meshopt_compression", "EXT_meshopt_compression"};
   testing::internal::CaptureStderr();
   parse(g);
   err = testing::internal::GetCapturedStderr();
-  EXPECT_NE(err.find("/extensionsUsed/0: extension 'KHR_texture_transform' is not supported"), std::string::npos) << err;
+  EXPECT_NE(err.find("/extensionsUsed/0: extension 'EXT_meshopt_compression' is not supported"), std::string::npos) << err;
   EXPECT_EQ(err.find("/extensionsUsed/1"), std::string::npos) << err;
 }
 
@@ -299,7 +341,39 @@ TEST(Gltf, DescribeListsAGltfScenesFeatures) {
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   std::ifstream in(out);
   std::string text((std::istreambuf_iterator<char>(in)), {});
-  for (const char* want : {"diffuse, emission, glass, microfacet", "mesh, spot", "textures:         1",
+  for (const char* want : {"glass, pbr", "mesh, spot", "textures:         1",
                            "path loop:        generic"})
     EXPECT_NE(text.find(want), std::string::npos) << want << "\n" << text;
+}
+
+// glTF's doubleSided: a single-sided emitter's back face sends nothing (the face is culled), a
+// double-sided one emits from both faces, for rays that hit it and for light sampling alike.
+TEST(Gltf, DoubleSidedEmittersEmitFromBothFaces) {
+  for (bool two : {false, true}) {
+    GltfDoc g = test::quad_doc();  // facing +z
+    g.doc["materials"][0] = {{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}},
+                             {"emissiveFactor", {1, 0.5, 0.25}}, {"doubleSided", two}};
+    RenderParams p;
+    auto scene = make_render_scene(parse(g), p);
+    ASSERT_EQ(scene->lights.size(), 1u);
+    const Light& l = scene->lights[0];
+    EXPECT_EQ(l.kind, LightKind::mesh);
+    EXPECT_EQ(l.two_sided, two);
+    LightSample front, back;
+    EXPECT_TRUE(sample_light(l, Vec3(0.1f, 0.2f, 2), Vec2{0.3f, 0.6f}, front));
+    const bool lit_behind = sample_light(l, Vec3(0.1f, 0.2f, -2), Vec2{0.3f, 0.6f}, back);
+    EXPECT_EQ(lit_behind, two);
+    if (lit_behind) {
+      EXPECT_NEAR(back.pdf, front.pdf, 1e-4f * front.pdf) << "the same point, mirrored";
+      EXPECT_EQ(back.radiance.x, 1.0f);
+    }
+    // A ray from behind sees the back face's emission only when it is double-sided.
+    SurfaceHit hit;
+    Ray r;
+    r.o = Vec3(0.2f, 0.1f, -3);
+    r.d = Vec3(0, 0, 1);
+    ASSERT_TRUE(scene->accel->intersect(r, hit));
+    const Vec3 seen = emitted_radiance(scene->materials[size_t(hit.material)], Vec3(0, 0, dot(-r.d, hit.ng)));
+    EXPECT_EQ(seen.y, two ? 0.5f : 0.0f);
+  }
 }

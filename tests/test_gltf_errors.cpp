@@ -112,10 +112,29 @@ TEST(GltfErrors, AccessorsAndIndicesOutOfRange) {
   g = test::quad_doc();
   g.doc["accessors"][0]["type"] = "VEC2";
   EXPECT_TRUE(fails_at(g.text(), "/meshes/0/primitives/0/attributes/POSITION (accessor 0): has the wrong type"));
-  g = test::quad_doc();
-  g.doc["accessors"][1]["sparse"] = {{"count", 1}, {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
-                                     {"values", {{"bufferView", 1}}}};
-  EXPECT_TRUE(fails_at(g.text(), "/meshes/0/primitives/0/indices (accessor 1): sparse accessors are not supported"));
+}
+
+// Sparse accessors (glTF 2.0, 3.6.2.3) substitute elements: the quad's third corner moves up to
+// z = 0.5. Indices out of range or not strictly increasing are located errors.
+TEST(GltfErrors, SparseAccessorsSubstituteAndCheckTheirIndices) {
+  auto sparse_doc = [](const std::vector<uint16_t>& which, const std::vector<float>& values) {
+    GltfDoc g = test::quad_doc();
+    const int iv = g.view(test::bytes_of(which)), vv = g.view(test::bytes_of(values));
+    g.doc["accessors"][0]["sparse"] = {{"count", which.size()},
+                                       {"indices", {{"bufferView", iv}, {"componentType", 5123}}},
+                                       {"values", {{"bufferView", vv}}}};
+    g.doc["accessors"][0]["max"] = {1, 1, 1};
+    return g;
+  };
+  SceneDesc d = parse_gltf(sparse_doc({2}, {1, 1, 0.5f}).text(), "sparse.gltf", false);
+  ASSERT_EQ(d.meshes.size(), 1u);
+  EXPECT_EQ(d.meshes[0].positions[2].z, 0.5f);
+  EXPECT_EQ(d.meshes[0].positions[1].z, 0.0f);
+  const std::string at = "/meshes/0/primitives/0/attributes/POSITION (accessor 0)/sparse";
+  EXPECT_TRUE(fails_at(sparse_doc({9}, {1, 1, 0.5f}).text(), at + "/indices: index 9 (element 0) is out of range"));
+  EXPECT_TRUE(fails_at(sparse_doc({2, 1}, {1, 1, 0.5f, 1, 1, 0.5f}).text(),
+                       at + "/indices: index 1 (element 1) does not increase strictly"));
+  EXPECT_TRUE(fails_at(sparse_doc({1, 2}, {1, 1, 0.5f}).text(), at + "/values: 24 bytes from byte 0 lie outside"));
 }
 
 TEST(GltfErrors, NonFiniteTransformsAndPositions) {

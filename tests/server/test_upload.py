@@ -97,7 +97,7 @@ def test_an_upload_over_max_scene_mb_is_refused_before_it_is_read(servers):
 def test_gltf_and_glb_uploads_load_render_and_are_stored_by_their_content(server):
     api = server.api
     glb = upload(api, "box", CORNELL_GLB.read_bytes(), expect=201, headers=GLB).json()
-    assert glb["summary"]["triangles"] > 0 and "emission" in glb["summary"]["materials"], glb
+    assert glb["summary"]["triangles"] > 0 and "pbr" in glb["summary"]["materials"], glb
     assert (server.data / "scenes" / "box.glb").read_bytes() == CORNELL_GLB.read_bytes()
     # A glTF with its buffers and images as data: URIs, sent as octet-stream: the content decides.
     shown = upload(api, "show", SHOWCASE.read_bytes(), expect=201,

@@ -1,0 +1,232 @@
+// The glTF metal-rough BSDF (pbr.h) and the GGX albedo tables its compensation reads (ggx.h).
+#include "pbr.h"
+
+#include "ggx.h"
+
+namespace pt {
+
+namespace ggx {
+namespace {
+
+// kAlbedoOne[j][i] and kAlbedoDielectric[k][j][i] at table_mu(i), table_roughness(j), table_eta(k).
+#include "ggx_tables.inc"
+
+// Position x in [0, 1] on an axis of n samples: the lower index and the weight of the upper one.
+inline int axis(float x, int n, float& frac) {
+  const float f = clampf(x, 0, 1) * float(n - 1);
+  const int i = std::min(int(f), n - 2);
+  frac = f - float(i);
+  return i;
+}
+
+// The mu axis is sqrt(mu) (table_mu).
+inline float bilinear(const float* t, float mu, float roughness) {
+  float fm, fr;
+  const int i = axis(std::sqrt(std::max(0.0f, mu)), kTableMu, fm), j = axis(roughness, kTableRough, fr);
+  const float a = t[j * kTableMu + i] * (1 - fm) + t[j * kTableMu + i + 1] * fm;
+  const float b = t[(j + 1) * kTableMu + i] * (1 - fm) + t[(j + 1) * kTableMu + i + 1] * fm;
+  return a * (1 - fr) + b * fr;
+}
+
+}  // namespace
+
+float albedo_one(float mu, float roughness) { return bilinear(&kAlbedoOne[0][0], mu, roughness); }
+
+float albedo_dielectric(float mu, float roughness, float eta) {
+  const float s = (eta - 1) / (eta + 1);
+  float fk;
+  const int k = axis((s - kTableMinSqrtF0) / (kTableMaxSqrtF0 - kTableMinSqrtF0), kTableEta, fk);
+  return bilinear(&kAlbedoDielectric[k][0][0], mu, roughness) * (1 - fk) +
+         bilinear(&kAlbedoDielectric[k + 1][0][0], mu, roughness) * fk;
+}
+
+}  // namespace ggx
+
+namespace {
+
+// What every query at one wo needs: the lobes' weights and their Fresnel and compensation terms.
+struct Lobes {
+  float alpha = 1;
+  bool flip = false;  // wo inside a transmissive material: the opaque lobes see the mirrored pair
+  float eta = 1.5f;
+  float f0 = 0.04f;   // the ior's head-on reflectance
+  Vec3 spec_a, spec_b;  // specular Fresnel F' = a + b F(ior) (KHR_materials_specular's remap)
+  Vec3 spec_comp;       // Turquin's 1 + F0 (1 - E) / E, specular layer
+  Vec3 metal_comp;      // the same for the metal
+  Vec3 metal_w, spec_w, diffuse_w, trans_w;  // each lobe's share of the material
+  float p_metal = 0, p_spec = 0, p_diffuse = 0, p_trans = 0;
+};
+
+inline Vec3 lerp3(Vec3 a, Vec3 b, float t) { return a * (1 - t) + b * t; }
+
+Lobes prepare(const PbrParams& p, Vec3 wo) {
+  Lobes l;
+  const float roughness = clampf(p.roughness, 0, 1);
+  l.alpha = ggx::alpha_of(roughness);
+  l.flip = wo.z < 0;
+  const float mu = std::min(1.0f, std::fabs(wo.z));
+  const float metallic = clampf(p.metallic, 0, 1), trans = clampf(p.transmission, 0, 1);
+  const Vec3 base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
+  l.eta = std::max(ggx::min_eta(), p.ior);
+  l.f0 = sqr((l.eta - 1) / (l.eta + 1));
+  const float e1 = std::max(1e-4f, ggx::albedo_one(mu, roughness));
+  const float ef = ggx::albedo_dielectric(mu, roughness, l.eta);
+
+  // Specular layer: F' = spec (F0t + (1 - F0t) (F - F0) / (1 - F0)), linear in F.
+  const float spec = std::max(0.0f, p.specular);
+  const Vec3 f0t = min(Vec3(1.0f), p.specular_color * l.f0);
+  const float inv = l.f0 < 1 ? 1 / (1 - l.f0) : 0.0f;
+  l.spec_b = (Vec3(1.0f) - f0t) * (spec * inv);
+  l.spec_a = f0t * spec - l.spec_b * l.f0;
+  l.spec_comp = Vec3(1.0f) + f0t * spec * (1 / e1 - 1);
+  const Vec3 spec_albedo = min(Vec3(1.0f), (l.spec_a * e1 + l.spec_b * ef) * l.spec_comp);
+  // The base sees what the layer leaves; one scalar for the three channels, as Cycles layers.
+  const float below = clampf(1 - max_component(spec_albedo), 0, 1);
+
+  l.metal_comp = Vec3(1.0f) + base * (1 / e1 - 1);
+  l.metal_w = Vec3(metallic);
+  l.spec_w = Vec3((1 - metallic) * (1 - trans));
+  l.diffuse_w = base * ((1 - metallic) * (1 - trans) * below);
+  l.trans_w = Vec3((1 - metallic) * trans);
+  // Expected weights towards wo pick the lobe to sample.
+  const Vec3 metal_albedo = lerp3(base, Vec3(1.0f), ggx::schlick_weight(mu));
+  l.p_metal = metallic * luminance(metal_albedo);
+  l.p_spec = (1 - metallic) * (1 - trans) * luminance(spec_albedo);
+  l.p_diffuse = luminance(l.diffuse_w);
+  l.p_trans = (1 - metallic) * trans;
+  const float total = l.p_metal + l.p_spec + l.p_diffuse + l.p_trans;
+  if (total > 0) {
+    l.p_metal /= total, l.p_spec /= total, l.p_diffuse /= total, l.p_trans /= total;
+  }
+  return l;
+}
+
+inline Vec3 mirrored(Vec3 w) { return Vec3(w.x, w.y, -w.z); }
+
+// The opaque lobes (metal, specular, diffuse) for wo, wi both above the surface: f and the
+// mixture's pdf share.
+void opaque(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
+  if (wo.z <= 0 || wi.z <= 0) return;
+  if (l.p_diffuse > 0) {
+    f += l.diffuse_w * kInvPi;
+    pdf += l.p_diffuse * wi.z * kInvPi;
+  }
+  if (l.p_metal <= 0 && l.p_spec <= 0) return;
+  const Vec3 h = normalize(wo + wi);
+  const float d = ggx::d(h, l.alpha);
+  if (!(d > 0)) return;
+  const float lobe = d * ggx::g2(wo, wi, l.alpha) / (4 * wo.z * wi.z);
+  const float c = dot(wo, h);
+  if (l.p_metal > 0) {
+    const Vec3 base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
+    f += l.metal_w * l.metal_comp * lerp3(base, Vec3(1.0f), ggx::schlick_weight(c)) * lobe;
+  }
+  if (l.p_spec > 0) f += l.spec_w * l.spec_comp * (l.spec_a + l.spec_b * ggx::fresnel(c, l.eta)) * lobe;
+  const float pdf_h = ggx::g1(wo, l.alpha) * d / (4 * wo.z);  // reflection through a visible normal
+  pdf += (l.p_metal + l.p_spec) * pdf_h;
+}
+
+// The rough dielectric (pbrt-v4's DielectricBxDF after Walter et al. 2007), radiance transport:
+// f and its pdf given that this lobe was chosen.
+void dielectric(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
+  const float co = wo.z, ci = wi.z;
+  if (co == 0 || ci == 0) return;
+  const bool reflect = co * ci > 0;
+  const float etap = reflect ? 1 : (co > 0 ? l.eta : 1 / l.eta);
+  Vec3 h = wi * etap + wo;
+  if (length_squared(h) == 0) return;
+  h = normalize(h);
+  if (h.z < 0) h = -h;
+  if (dot(h, wi) * ci < 0 || dot(h, wo) * co < 0) return;  // back-facing microfacets
+  const float fr = ggx::fresnel(dot(wo, h), l.eta);
+  const float d = ggx::d(h, l.alpha), g = ggx::g2(wo, wi, l.alpha);
+  const float dv = ggx::d_visible(wo, h, l.alpha);
+  if (reflect) {
+    f += Vec3(d * g * fr / std::fabs(4 * ci * co));
+    pdf += dv / (4 * std::fabs(dot(wo, h))) * fr;
+    return;
+  }
+  const float denom = sqr(dot(wi, h) + dot(wo, h) / etap);
+  if (!(denom > 0)) return;
+  const float ft = d * (1 - fr) * g * std::fabs(dot(wi, h) * dot(wo, h) / (ci * co * denom)) / (etap * etap);
+  const Vec3 base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
+  f += base * ft;  // glTF tints what passes by the base colour
+  pdf += dv * std::fabs(dot(wi, h)) / denom * (1 - fr);
+}
+
+void eval_all(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
+  f = Vec3(0.0f);
+  pdf = 0;
+  if (l.flip) opaque(p, l, mirrored(wo), mirrored(wi), f, pdf);
+  else opaque(p, l, wo, wi, f, pdf);
+  if (l.p_trans > 0) {
+    Vec3 ft(0.0f);
+    float pt = 0;
+    dielectric(p, l, wo, wi, ft, pt);
+    f += l.trans_w * ft;
+    pdf += l.p_trans * pt;
+  }
+  if (!is_finite(f) || !std::isfinite(pdf)) f = Vec3(0.0f), pdf = 0;
+}
+
+}  // namespace
+
+Vec3 pbr_eval(const PbrParams& p, Vec3 wo, Vec3 wi) {
+  Vec3 f;
+  float pdf;
+  eval_all(p, prepare(p, wo), wo, wi, f, pdf);
+  return f;
+}
+
+float pbr_pdf(const PbrParams& p, Vec3 wo, Vec3 wi) {
+  Vec3 f;
+  float pdf;
+  eval_all(p, prepare(p, wo), wo, wi, f, pdf);
+  return pdf;
+}
+
+PbrLobeWeights pbr_lobe_weights(const PbrParams& p, Vec3 wo) {
+  const Lobes l = prepare(p, wo);
+  return {l.p_metal, l.p_spec, l.p_diffuse, l.p_trans};
+}
+
+bool pbr_sample(const PbrParams& p, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s) {
+  s.delta = false;
+  if (wo.z == 0) return false;
+  const Lobes l = prepare(p, wo);
+  const Vec3 wo_up = l.flip ? mirrored(wo) : wo;  // the opaque lobes' view
+  Vec3 wi;
+  float x = u_lobe;
+  if (x < l.p_diffuse) {
+    wi = sample_cosine_hemisphere(u);
+    if (l.flip) wi = mirrored(wi);
+  } else if ((x -= l.p_diffuse) < l.p_metal + l.p_spec) {
+    wi = reflect(wo_up, ggx::sample_visible(wo_up, l.alpha, u));
+    if (wi.z <= 0) return false;
+    if (l.flip) wi = mirrored(wi);
+  } else {
+    x -= l.p_metal + l.p_spec;
+    if (!(l.p_trans > 0)) return false;
+    // Reflect or refract through a visible normal, in proportion to Fresnel (the remapped draw).
+    const Vec3 h = ggx::sample_visible(wo, l.alpha, u);
+    const float fr = ggx::fresnel(dot(wo, h), l.eta);
+    if (clampf(x / l.p_trans, 0, 1) < fr) {
+      wi = reflect(wo, h);
+      if (wi.z * wo.z <= 0) return false;
+    } else {
+      float etap;
+      if (!ggx::refract(wo, h, l.eta, etap, wi)) return false;
+      if (wi.z * wo.z >= 0) return false;
+    }
+  }
+  Vec3 f;
+  float pdf;
+  eval_all(p, l, wo, wi, f, pdf);
+  if (!(pdf > 0) || is_black(f)) return false;
+  s.wi = wi;
+  s.pdf = pdf;
+  s.weight = f * (std::fabs(wi.z) / pdf);
+  return is_finite(s.weight);
+}
+
+}  // namespace pt

@@ -1,0 +1,60 @@
+// A glTF material at a hit (render_scene.h, textured_material): the factors times the textures at
+// the hit's texture coordinates (glTF 2.0, 3.9), the vertex colour, and the normal map's bend of
+// the shading normal in the tangent frame the mesh gives (3.9.3, MikkTSpace's convention).
+#include "render_scene.h"
+#include "texture.h"
+
+namespace pt {
+
+namespace {
+
+Vec3 lookup(const RenderScene& scene, const TextureRef& ref, const HitAttributes& at) {
+  Vec2 uv = at.uv[ref.set == 1 ? 1 : 0];
+  if (ref.transformed) {
+    const float* m = ref.m;
+    uv = Vec2{m[0] * uv.x + m[1] * uv.y + m[2], m[3] * uv.x + m[4] * uv.y + m[5]};
+  }
+  return eval_texture((*scene.textures)[size_t(ref.texture)], uv);
+}
+
+// The shading normal bent by a tangent-space normal n_t (components in [-1, 1], x and y scaled):
+// tangent made orthogonal to ns, bitangent = cross(ns, tangent) x sign (glTF 2.0, 3.7.2.1).
+Vec3 bend(Vec3 ns, const HitAttributes& at, Vec3 n_t) {
+  const Vec3 t = at.tangent - ns * dot(ns, at.tangent);
+  if (!(length_squared(t) > 1e-20f)) return ns;
+  const Vec3 tu = normalize(t), b = cross(ns, tu) * at.sign;
+  const Vec3 n = normalize(tu * n_t.x + b * n_t.y + ns * n_t.z);
+  return is_finite(n) && !is_black(n) ? n : ns;
+}
+
+}  // namespace
+
+[[gnu::noinline]] const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit,
+                                                    Vec3& ns) {
+  thread_local Material scratch;
+  const PbrParams& in = m.pbr;
+  PbrParams& p = scratch.pbr;
+  scratch.type = MaterialType::pbr;
+  p = in;
+  p.base_tex = p.metal_rough_tex = p.emissive_tex = p.normal_tex = p.transmission_tex = TextureRef();
+  p.vertex_color = false;
+  const HitAttributes at = scene.accel->attributes(hit);
+  if (in.base_tex.used()) p.base = p.base * lookup(scene, in.base_tex, at);
+  if (in.vertex_color) p.base = p.base * at.color;
+  if (in.metal_rough_tex.used()) {  // roughness in G, metalness in B
+    const Vec3 mr = lookup(scene, in.metal_rough_tex, at);
+    p.roughness *= mr.y;
+    p.metallic *= mr.z;
+  }
+  if (in.emissive_tex.used()) p.emissive = p.emissive * lookup(scene, in.emissive_tex, at);
+  if (in.transmission_tex.used()) p.transmission *= lookup(scene, in.transmission_tex, at).x;
+  if (in.normal_tex.used()) {
+    const Vec3 c = lookup(scene, in.normal_tex, at);
+    Vec3 n_t = c * 2.0f - Vec3(1.0f);
+    n_t.x *= in.normal_scale, n_t.y *= in.normal_scale;
+    ns = bend(ns, at, n_t);
+  }
+  return scratch;
+}
+
+}  // namespace pt
