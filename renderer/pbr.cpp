@@ -8,7 +8,8 @@ namespace pt {
 namespace ggx {
 namespace {
 
-// kAlbedoOne[j][i] and kAlbedoDielectric[k][j][i] at table_mu(i), table_roughness(j), table_eta(k).
+// kAlbedoOne[j kTableMu + i] and kAlbedoDielectric[(k kTableRough + j) kTableMu + i] at table_mu(i),
+// table_roughness(j), table_eta(k).
 #include "ggx_tables.inc"
 
 // Position x in [0, 1] on an axis of n samples: the lower index and the weight of the upper one.
@@ -30,14 +31,14 @@ inline float bilinear(const float* t, float mu, float roughness) {
 
 }  // namespace
 
-float albedo_one(float mu, float roughness) { return bilinear(&kAlbedoOne[0][0], mu, roughness); }
+float albedo_one(float mu, float roughness) { return bilinear(kAlbedoOne, mu, roughness); }
 
 float albedo_dielectric(float mu, float roughness, float eta) {
   const float s = (eta - 1) / (eta + 1);
   float fk;
   const int k = axis((s - kTableMinSqrtF0) / (kTableMaxSqrtF0 - kTableMinSqrtF0), kTableEta, fk);
-  return bilinear(&kAlbedoDielectric[k][0][0], mu, roughness) * (1 - fk) +
-         bilinear(&kAlbedoDielectric[k + 1][0][0], mu, roughness) * fk;
+  const float* t = kAlbedoDielectric + k * kTableRough * kTableMu;
+  return bilinear(t, mu, roughness) * (1 - fk) + bilinear(t + kTableRough * kTableMu, mu, roughness) * fk;
 }
 
 }  // namespace ggx
