@@ -279,7 +279,7 @@ void Builder::add_primitive(const tinygltf::Primitive& prim, const Mat4& world, 
   const PbrParams& pm = m_desc.materials[size_t(mat)].pbr;
   for (int set = 0; set < 2; ++set) {
     bool read = false;
-    for (const TextureRef* r : {&pm.base_tex, &pm.metal_rough_tex, &pm.emissive_tex, &pm.normal_tex, &pm.transmission_tex})
+    for (const TextureRef* r : pm.texture_refs())
       read |= r->used() && r->set == set;
     if (!read) continue;
     const std::string key = "TEXCOORD_" + std::to_string(set);

@@ -208,6 +208,4 @@ Vec3 emitted_radiance(const Material& m, Vec3 wo) {
   return m.type == MaterialType::emission ? m.radiance : Vec3(0.0f);
 }
 
-bool chooses_lobe(const Material& m) { return is_transmissive(m) || m.type == MaterialType::pbr; }
-
 }  // namespace pt

@@ -45,9 +45,6 @@ Vec3 eval_bsdf(const Material& m, Vec3 wo, Vec3 wi);
 float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi);
 // Samples wi given two uniform numbers for the direction and one for the lobe choice.
 bool sample_bsdf(const Material& m, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s);
-// Whether sampling draws a number to choose among lobes (glass, refraction, the glTF material):
-// the others skip that draw.
-bool chooses_lobe(const Material& m);
 // Radiance an emissive surface sends towards wo (local frame; the front side, wo.z > 0, emits, and
 // the back too for a double-sided glTF material).
 Vec3 emitted_radiance(const Material& m, Vec3 wo);

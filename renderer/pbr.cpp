@@ -48,6 +48,7 @@ namespace {
 // What every query at one wo needs: the lobes' weights and their Fresnel and compensation terms.
 struct Lobes {
   float alpha = 1;
+  Vec3 base;          // the base colour, clamped to [0, 1]
   bool flip = false;  // wo inside a transmissive material: the opaque lobes see the mirrored pair
   float eta = 1.5f;
   float f0 = 0.04f;   // the ior's head-on reflectance
@@ -67,7 +68,7 @@ Lobes prepare(const PbrParams& p, Vec3 wo) {
   l.flip = wo.z < 0;
   const float mu = std::min(1.0f, std::fabs(wo.z));
   const float metallic = clampf(p.metallic, 0, 1), trans = clampf(p.transmission, 0, 1);
-  const Vec3 base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
+  const Vec3 base = l.base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
   l.eta = std::max(ggx::min_eta(), p.ior);
   l.f0 = sqr((l.eta - 1) / (l.eta + 1));
   const float e1 = std::max(1e-4f, ggx::albedo_one(mu, roughness));
@@ -106,7 +107,7 @@ inline Vec3 mirrored(Vec3 w) { return Vec3(w.x, w.y, -w.z); }
 
 // The opaque lobes (metal, specular, diffuse) for wo, wi both above the surface: f and the
 // mixture's pdf share.
-void opaque(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
+void opaque(const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
   if (wo.z <= 0 || wi.z <= 0) return;
   if (l.p_diffuse > 0) {
     f += l.diffuse_w * kInvPi;
@@ -118,10 +119,7 @@ void opaque(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float
   if (!(d > 0)) return;
   const float lobe = d * ggx::g2(wo, wi, l.alpha) / (4 * wo.z * wi.z);
   const float c = dot(wo, h);
-  if (l.p_metal > 0) {
-    const Vec3 base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
-    f += l.metal_w * l.metal_comp * lerp3(base, Vec3(1.0f), ggx::schlick_weight(c)) * lobe;
-  }
+  if (l.p_metal > 0) f += l.metal_w * l.metal_comp * lerp3(l.base, Vec3(1.0f), ggx::schlick_weight(c)) * lobe;
   if (l.p_spec > 0) f += l.spec_w * l.spec_comp * (l.spec_a + l.spec_b * ggx::fresnel(c, l.eta)) * lobe;
   const float pdf_h = ggx::g1(wo, l.alpha) * d / (4 * wo.z);  // reflection through a visible normal
   pdf += (l.p_metal + l.p_spec) * pdf_h;
@@ -129,7 +127,7 @@ void opaque(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float
 
 // The rough dielectric (pbrt-v4's DielectricBxDF after Walter et al. 2007), radiance transport:
 // f and its pdf given that this lobe was chosen.
-void dielectric(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
+void dielectric(const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
   const float co = wo.z, ci = wi.z;
   if (co == 0 || ci == 0) return;
   const bool reflect = co * ci > 0;
@@ -150,20 +148,19 @@ void dielectric(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, f
   const float denom = sqr(dot(wi, h) + dot(wo, h) / etap);
   if (!(denom > 0)) return;
   const float ft = d * (1 - fr) * g * std::fabs(dot(wi, h) * dot(wo, h) / (ci * co * denom)) / (etap * etap);
-  const Vec3 base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
-  f += base * ft;  // glTF tints what passes by the base colour
+  f += l.base * ft;  // glTF tints what passes by the base colour
   pdf += dv * std::fabs(dot(wi, h)) / denom * (1 - fr);
 }
 
-void eval_all(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
+void eval_all(const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
   f = Vec3(0.0f);
   pdf = 0;
-  if (l.flip) opaque(p, l, mirrored(wo), mirrored(wi), f, pdf);
-  else opaque(p, l, wo, wi, f, pdf);
+  if (l.flip) opaque(l, mirrored(wo), mirrored(wi), f, pdf);
+  else opaque(l, wo, wi, f, pdf);
   if (l.p_trans > 0) {
     Vec3 ft(0.0f);
     float pt = 0;
-    dielectric(p, l, wo, wi, ft, pt);
+    dielectric(l, wo, wi, ft, pt);
     f += l.trans_w * ft;
     pdf += l.p_trans * pt;
   }
@@ -175,14 +172,14 @@ void eval_all(const PbrParams& p, const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, flo
 Vec3 pbr_eval(const PbrParams& p, Vec3 wo, Vec3 wi) {
   Vec3 f;
   float pdf;
-  eval_all(p, prepare(p, wo), wo, wi, f, pdf);
+  eval_all(prepare(p, wo), wo, wi, f, pdf);
   return f;
 }
 
 float pbr_pdf(const PbrParams& p, Vec3 wo, Vec3 wi) {
   Vec3 f;
   float pdf;
-  eval_all(p, prepare(p, wo), wo, wi, f, pdf);
+  eval_all(prepare(p, wo), wo, wi, f, pdf);
   return pdf;
 }
 
@@ -222,7 +219,7 @@ bool pbr_sample(const PbrParams& p, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s
   }
   Vec3 f;
   float pdf;
-  eval_all(p, l, wo, wi, f, pdf);
+  eval_all(l, wo, wi, f, pdf);
   if (!(pdf > 0) || is_black(f)) return false;
   s.wi = wi;
   s.pdf = pdf;

@@ -19,7 +19,7 @@ namespace {
 // What a textured material reads that the mesh lacks, or nullptr.
 const char* unreadable_textures(const PbrParams& p, const MeshDesc& mesh, size_t textures) {
   const size_t nv = mesh.positions.size();
-  for (const TextureRef* r : {&p.base_tex, &p.metal_rough_tex, &p.emissive_tex, &p.normal_tex, &p.transmission_tex}) {
+  for (const TextureRef* r : p.texture_refs()) {
     if (!r->used()) continue;
     if (size_t(r->texture) >= textures) return "its texture";
     if ((r->set == 0 ? mesh.uvs : mesh.uvs1).size() != nv) return "texture coordinates";
@@ -121,12 +121,14 @@ SceneBase make_scene_base(const SceneDesc& desc) {
 
   // Emissive mesh triangles become one mesh light per (mesh, material), sampled by area.
   std::vector<std::vector<int>> mesh_light(desc.meshes.size());
+  bool emitters = false;  // an emitter lights the scene even where it is no light (a textured one)
   for (size_t mi = 0; mi < desc.meshes.size(); ++mi) {
     const MeshDesc& mesh = desc.meshes[mi];
     std::map<int, int> light_of_material;
     for (size_t t = 0; t < mesh.tri_material.size(); ++t) {
       int mat = mesh.tri_material[t];
       if (!is_emissive(base.materials[mat])) continue;
+      emitters = true;
       // A textured emitter is no light: hits find its radiance, light sampling could not.
       if (base.materials[mat].type == MaterialType::pbr && base.materials[mat].pbr.emissive_tex.used()) continue;
       const uint32_t* vi = &mesh.indices[3 * t];
@@ -189,7 +191,10 @@ SceneBase make_scene_base(const SceneDesc& desc) {
   // Textured materials, on meshes that carry what they read (the loaders guarantee it).
   for (size_t mi = 0; mi < desc.meshes.size(); ++mi) {
     const MeshDesc& mesh = desc.meshes[mi];
+    int last = -1;  // a mesh's triangles share few materials: each is checked once per run
     for (int t : mesh.tri_material) {
+      if (t == last) continue;
+      last = t;
       const Material& m = base.materials[size_t(t)];
       if (!m.textured()) continue;
       if (const char* why = unreadable_textures(m.pbr, mesh, desc.textures.size()))
@@ -206,10 +211,6 @@ SceneBase make_scene_base(const SceneDesc& desc) {
     f.textures = desc.textures.size();
   }
   if (pbr || f.textured) f.bits = kFeatAll;  // glTF materials take the generic loop (path_tracer_for)
-  // An emitter lights the scene even where it is no light (a textured one): no default light then.
-  bool emitters = false;
-  for (const MeshDesc& mesh : desc.meshes)
-    for (int t : mesh.tri_material) emitters |= is_emissive(base.materials[size_t(t)]);
   base.default_light = desc.default_light && !emitters;
   base.triangle_count = desc.triangle_count();
   base.sphere_count = desc.spheres.size();

@@ -39,9 +39,14 @@ struct PbrParams {
   bool vertex_color = false;               // the mesh's COLOR_0 multiplies the base colour
   bool double_sided = false;               // doubleSided: emission leaves both faces
   TextureRef base_tex, metal_rough_tex, emissive_tex, normal_tex, transmission_tex;
+  // Every texture slot, for what looks at them all (the loader's uv sets, the mesh checks).
+  std::array<const TextureRef*, 5> texture_refs() const {
+    return {&base_tex, &metal_rough_tex, &emissive_tex, &normal_tex, &transmission_tex};
+  }
   bool textured() const {
-    return vertex_color || base_tex.used() || metal_rough_tex.used() || emissive_tex.used() || normal_tex.used() ||
-           transmission_tex.used();
+    bool any = vertex_color;
+    for (const TextureRef* r : texture_refs()) any |= r->used();
+    return any;
   }
 };
 
