@@ -7,7 +7,8 @@ Each scene has a camera (4:3) and a black world; its textures are generated here
 the .glb (128x128 PNGs). The scenes: mr_grid (a 5x5 metallic/roughness sphere grid under an
 emissive panel), plastic (dielectric specular layer at roughness 0.05, 0.2, 0.5), textured (checker
 base colour, metallic-roughness and normal-map textures), glass (transmission at roughness 0 and
-0.3), clearcoat (over a red base), punctual (point, spot and sun lights on diffuse objects).
+0.3), clearcoat (over a red base), punctual (point, spot and sun lights on diffuse objects), alpha
+(a cut-out leaf, a fading card, a card of constant alpha), sheen (cloth-like spheres).
 Blender's exporter orders vertices differently from run to run (the same triangles), so a rewritten
 scene has a new content hash and vs_cycles.py renders new references for it.
 """
@@ -121,12 +122,14 @@ def light(kind, name, location, energy, colour=(1, 1, 1), target=None, **props):
         look(obj, target)
 
 
-def image(name, rgb, colour_space):
-    """A packed image from a (TEX, TEX, 3) array of 0..1 values, row 0 at the top."""
-    img = bpy.data.images.new(name, TEX, TEX, alpha=False)
+def image(name, rgb, colour_space, alpha=None):
+    """A packed image from a (TEX, TEX, 3) array of 0..1 values, row 0 at the top (and its alpha)."""
+    img = bpy.data.images.new(name, TEX, TEX, alpha=alpha is not None)
     img.colorspace_settings.name = colour_space  # first: it regenerates a generated image's pixels
     rgba = np.ones((TEX, TEX, 4), np.float32)
     rgba[..., :3] = rgb[::-1]  # Blender's rows run bottom-up
+    if alpha is not None:
+        rgba[..., 3] = alpha[::-1]
     img.pixels.foreach_set(rgba.ravel())
     img.update()
     img.file_format = "PNG"
@@ -241,6 +244,52 @@ def clearcoat():
     camera((0, -4.5, 2.2), (0, 0, 0.5), 40)
 
 
+def alpha():
+    """Cards standing on the floor under the panel: a leaf cut out (MASK, as Blender's 1 - (alpha <
+    0.5) writes it), a card whose alpha fades across it (BLEND), one of constant alpha 0.4 (BLEND)."""
+    stage()
+    y, x = np.mgrid[0:TEX, 0:TEX] + 0.5
+    u, v = x / TEX * 2 - 1, y / TEX * 2 - 1
+    leaf = ((u / 0.55) ** 2 + (v / 0.95) ** 2 < 1) & (np.abs(u) > 0.04)  # an ellipse split by its vein
+    green = np.zeros((TEX, TEX, 3)) + np.array([0.15, 0.5, 0.1])
+    fade = np.broadcast_to(x / TEX, (TEX, TEX))
+    orange = np.zeros((TEX, TEX, 3)) + np.array([0.8, 0.35, 0.1])
+    cards = (("leaf", green, leaf.astype(float), True), ("fade", orange, fade, False))
+    for i, (name, rgb, a, clip) in enumerate(cards):
+        mat = material(name)
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        bsdf = nodes["Principled BSDF"]
+        tex = nodes.new("ShaderNodeTexImage")
+        tex.image = image(f"{name} texture", rgb, "sRGB", a)
+        links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+        alpha_out = tex.outputs["Alpha"]
+        if clip:
+            less, one_minus = nodes.new("ShaderNodeMath"), nodes.new("ShaderNodeMath")
+            less.operation, one_minus.operation = "LESS_THAN", "SUBTRACT"
+            less.inputs[1].default_value = 0.5
+            one_minus.inputs[0].default_value = 1.0
+            links.new(alpha_out, less.inputs[0])
+            links.new(less.outputs[0], one_minus.inputs[1])
+            alpha_out = one_minus.outputs[0]
+        links.new(alpha_out, bsdf.inputs["Alpha"])
+        plane(f"{name} card", mat, ((i - 1) * 1.4, 0, 0.8), (1.2, 1.6), (math.radians(90), 0, 0))
+    plane("glass card", material("constant alpha", (0.2, 0.3, 0.8), Alpha=0.4), (1.4, 0, 0.8), (1.2, 1.6),
+          (math.radians(90), 0, 0))
+    camera((0.4, -4.5, 2.0), (0, 0, 0.6), 40)
+
+
+def sheen():
+    """Sheen (Blender's Sheen Weight 1, glTF's KHR_materials_sheen) on dark cloth-like spheres."""
+    stage()
+    looks = (("no sheen", (0, 0, 0), 0.3), ("sheen r0.3", (1.0, 0.85, 0.7), 0.3), ("sheen r0.8", (0.6, 0.8, 1.0), 0.8))
+    for i, (name, tint, sheen_roughness) in enumerate(looks):
+        weight = 1.0 if max(tint) > 0 else 0.0
+        mat = material(name, (0.25, 0.04, 0.08), Roughness=0.9, Sheen_Weight=weight, Sheen_Tint=tint,
+                       Sheen_Roughness=sheen_roughness)
+        sphere(name, mat, ((i - 1) * 1.3, 0, 0.55), 0.55)
+    camera((0, -4.5, 2.2), (0, 0, 0.5), 40)
+
+
 def punctual():
     """Diffuse objects under a point, a spot and a sun: no emissive surface."""
     white = material("white", (0.75, 0.75, 0.75), Roughness=1.0)
@@ -257,7 +306,7 @@ def punctual():
 
 
 SCENES = {"mr_grid": mr_grid, "plastic": plastic, "textured": textured, "glass": glass, "clearcoat": clearcoat,
-          "punctual": punctual}
+          "punctual": punctual, "alpha": alpha, "sheen": sheen}
 
 
 def main():

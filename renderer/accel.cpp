@@ -49,8 +49,11 @@ struct GeomInfo {
   // Vertex attributes for Accel::attributes, each empty when the mesh has none.
   std::vector<Vec2> uv0, uv1;
   std::vector<Vec3> colors;
+  std::vector<float> color_alpha;
   std::vector<std::array<float, 4>> tangents;
-  bool has_attributes() const { return !uv0.empty() || !uv1.empty() || !colors.empty() || !tangents.empty(); }
+  bool has_attributes() const {
+    return !uv0.empty() || !uv1.empty() || !colors.empty() || !color_alpha.empty() || !tangents.empty();
+  }
   const float* spheres = nullptr;     // x y z r per sphere
   std::vector<float> sphere_data;     // what `spheres` points to (Embree user geometry reads it)
   std::vector<int> sphere_material;
@@ -132,6 +135,44 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   }
 }
 
+// The vertex attributes of triangle `prim` at barycentrics (u, v) of its vertices 1 and 2.
+HitAttributes interpolate(const GeomInfo& g, uint32_t prim, float u, float v) {
+  HitAttributes out;
+  if (g.kind == GeomKind::spheres || size_t(prim) >= g.tris.size()) return out;
+  const uint32_t* tri = g.indices + 3 * size_t(prim);
+  const float w = 1 - u - v;
+  auto mix2 = [&](const std::vector<Vec2>& x) {
+    return Vec2{x[tri[0]].x * w + x[tri[1]].x * u + x[tri[2]].x * v, x[tri[0]].y * w + x[tri[1]].y * u + x[tri[2]].y * v};
+  };
+  if (!g.uv0.empty()) out.uv[0] = mix2(g.uv0);
+  if (!g.uv1.empty()) out.uv[1] = mix2(g.uv1);
+  if (!g.colors.empty()) out.color = g.colors[tri[0]] * w + g.colors[tri[1]] * u + g.colors[tri[2]] * v;
+  if (!g.color_alpha.empty())
+    out.alpha = g.color_alpha[tri[0]] * w + g.color_alpha[tri[1]] * u + g.color_alpha[tri[2]] * v;
+  if (!g.tangents.empty()) {
+    const auto &t0 = g.tangents[tri[0]], &t1 = g.tangents[tri[1]], &t2 = g.tangents[tri[2]];
+    out.tangent = Vec3(t0[0], t0[1], t0[2]) * w + Vec3(t1[0], t1[1], t1[2]) * u + Vec3(t2[0], t2[1], t2[2]) * v;
+    out.sign = t0[3] < 0 ? -1.0f : 1.0f;
+  }
+  return out;
+}
+
+// A uniform number in [0, 1) from a ray and a triangle: the same ray meets the same triangle with
+// the same answer (packets and single rays agree, renders repeat), different rays independently.
+inline uint32_t mix32(uint32_t h) {  // a 32-bit finaliser (Wellons' "lowbias32")
+  h ^= h >> 16, h *= 0x7feb352du, h ^= h >> 15, h *= 0x846ca68bu, h ^= h >> 16;
+  return h;
+}
+inline float ray_uniform(const float* f, int n, uint32_t prim) {
+  uint32_t h = mix32(prim * 0x9e3779b9u + 1);
+  for (int i = 0; i < n; ++i) {
+    uint32_t bits;
+    std::memcpy(&bits, &f[i], 4);
+    h = mix32(h ^ bits);
+  }
+  return float(h >> 8) * 0x1p-24f;
+}
+
 }  // namespace
 
 struct Accel::Impl {
@@ -151,6 +192,8 @@ struct Accel::Impl {
   // instructions per pass on AVX2 (docs/performance.md).
   int packet_width = 16;
   bool attributes = false;  // some mesh has uvs or colours: hits interpolate them
+  CoverageTest coverage;             // alpha-tested materials (Embree filters on their meshes)
+  std::vector<uint8_t> tested;       // per material: alpha-tested
 
   void check(const char* what) {
     std::lock_guard<std::mutex> lock(error.mutex);
@@ -162,10 +205,41 @@ struct Accel::Impl {
   }
 };
 
+namespace {
+
+// Embree's filter on meshes with alpha-tested triangles, for intersect and occluded queries of
+// every width: a hit the coverage test refuses is ignored and traversal goes on behind it.
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto& a = *static_cast<const Accel::Impl*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const unsigned geom = RTCHitN_geomID(args->hit, args->N, i), prim = RTCHitN_primID(args->hit, args->N, i);
+    const GeomInfo& g = a.geoms[geom];
+    const int material = g.tris[prim].material;
+    if (material < 0 || size_t(material) >= a.tested.size() || !a.tested[size_t(material)]) continue;
+    const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+    const float ray[6] = {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                          RTCRayN_org_z(args->ray, args->N, i), RTCRayN_dir_x(args->ray, args->N, i),
+                          RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i)};
+    if (!a.coverage(material, interpolate(g, prim, u, v), ray_uniform(ray, 6, prim))) args->valid[i] = 0;
+  }
+}
+
+}  // namespace
+
 Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
-             const std::vector<std::vector<int>>& mesh_light)
+             const std::vector<std::vector<int>>& mesh_light, CoverageTest coverage)
     : m_impl(std::make_unique<Impl>()) {
   Impl& a = *m_impl;
+  if (coverage) {
+    a.tested.resize(desc.materials.size());
+    bool any = false;
+    for (size_t m = 0; m < desc.materials.size(); ++m) {
+      const Material& mat = desc.materials[m];
+      any |= a.tested[m] = mat.type == MaterialType::pbr && mat.pbr.alpha_tested();
+    }
+    if (any) a.coverage = std::move(coverage);
+  }
   a.device = rtcNewDevice(nullptr);
   if (!a.device) throw std::runtime_error("Embree: cannot create device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
   rtcSetDeviceErrorFunction(a.device, on_device_error, &a.error);
@@ -179,6 +253,14 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
   auto add_triangles = [&](const std::vector<Vec3>& pos, const std::vector<uint32_t>& idx,
                            const std::vector<int>& tri_material, const std::vector<int>& tri_light, GeomInfo info) {
     RTCGeometry g = rtcNewGeometry(a.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    bool alpha = false;
+    for (size_t t = 0; a.coverage && t < tri_material.size() && !alpha; ++t)
+      alpha = tri_material[t] >= 0 && size_t(tri_material[t]) < a.tested.size() && a.tested[size_t(tri_material[t])];
+    if (alpha) {
+      rtcSetGeometryUserData(g, &a);
+      rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
+    }
     auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                            3 * sizeof(float), pos.size()));
     auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
@@ -194,7 +276,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     }
     a.bytes += info.normals.size() * sizeof(float) + info.tris.size() * sizeof(TriangleInfo) +
                (info.uv0.size() + info.uv1.size()) * sizeof(Vec2) + info.colors.size() * sizeof(Vec3) +
-               info.tangents.size() * 4 * sizeof(float);
+               info.color_alpha.size() * sizeof(float) + info.tangents.size() * 4 * sizeof(float);
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(a.scene, g);
     rtcReleaseGeometry(g);
@@ -219,6 +301,7 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
     if (mesh.uvs.size() == nv) info.uv0 = mesh.uvs;
     if (mesh.uvs1.size() == nv) info.uv1 = mesh.uvs1;
     if (mesh.colors.size() == nv) info.colors = mesh.colors;
+    if (mesh.color_alpha.size() == nv) info.color_alpha = mesh.color_alpha;
     if (mesh.tangents.size() == nv) info.tangents = mesh.tangents;
     static const std::vector<int> none;
     add_triangles(mesh.positions, mesh.indices, mesh.tri_material, m < mesh_light.size() ? mesh_light[m] : none,
@@ -470,25 +553,9 @@ bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
 }
 
 HitAttributes Accel::attributes(const SurfaceHit& hit) const {
-  HitAttributes out;
   const Impl& a = *m_impl;
-  if (hit.geom >= a.geoms.size()) return out;
-  const GeomInfo& g = a.geoms[hit.geom];
-  if (g.kind == GeomKind::spheres || size_t(hit.prim) >= g.tris.size()) return out;
-  const uint32_t* tri = g.indices + 3 * size_t(hit.prim);
-  const float w = 1 - hit.bu - hit.bv, u = hit.bu, v = hit.bv;
-  auto mix2 = [&](const std::vector<Vec2>& x) {
-    return Vec2{x[tri[0]].x * w + x[tri[1]].x * u + x[tri[2]].x * v, x[tri[0]].y * w + x[tri[1]].y * u + x[tri[2]].y * v};
-  };
-  if (!g.uv0.empty()) out.uv[0] = mix2(g.uv0);
-  if (!g.uv1.empty()) out.uv[1] = mix2(g.uv1);
-  if (!g.colors.empty()) out.color = g.colors[tri[0]] * w + g.colors[tri[1]] * u + g.colors[tri[2]] * v;
-  if (!g.tangents.empty()) {
-    const auto &t0 = g.tangents[tri[0]], &t1 = g.tangents[tri[1]], &t2 = g.tangents[tri[2]];
-    out.tangent = Vec3(t0[0], t0[1], t0[2]) * w + Vec3(t1[0], t1[1], t1[2]) * u + Vec3(t2[0], t2[1], t2[2]) * v;
-    out.sign = t0[3] < 0 ? -1.0f : 1.0f;
-  }
-  return out;
+  if (hit.geom >= a.geoms.size()) return HitAttributes();
+  return interpolate(a.geoms[hit.geom], hit.prim, hit.bu, hit.bv);
 }
 
 bool Accel::occluded(const Ray& ray) const {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -43,14 +44,21 @@ struct HitAttributes {
   Vec3 color{1, 1, 1};
   Vec3 tangent;     // world space, not normalised; zero when the mesh has none
   float sign = 1;   // the bitangent's handedness
+  float alpha = 1;  // COLOR_0's alpha (MeshDesc::color_alpha)
 };
+
+// Whether a ray that meets an alpha-tested material (PbrParams::alpha_tested) at a point with
+// attributes `at` stops there; `u` is uniform in [0, 1), drawn from the ray and the triangle, for
+// stochastic pass-through. Accel asks it during traversal, for every kind of ray.
+using CoverageTest = std::function<bool(int material, const HitAttributes& at, float u)>;
 
 class Accel {
  public:
   // Builds the acceleration structure once. `mesh_light` gives, per mesh and triangle, the light
-  // index of emissive triangles (or -1); it may be empty.
+  // index of emissive triangles (or -1); it may be empty. `coverage` decides the hits on
+  // triangles of alpha-tested materials; without it they are opaque.
   Accel(const SceneDesc& scene, const std::vector<EmitterPanel>& panels,
-        const std::vector<std::vector<int>>& mesh_light);
+        const std::vector<std::vector<int>>& mesh_light, CoverageTest coverage = {});
   ~Accel();
   Accel(const Accel&) = delete;
   Accel& operator=(const Accel&) = delete;

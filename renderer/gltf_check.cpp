@@ -36,9 +36,33 @@ void Checker::materials() {
       if (const json* e = object(*ext, "KHR_materials_specular", at)) {
         number(*e, "specularFactor", at + "/KHR_materials_specular", false, 0, 1);
         numbers(*e, "specularColorFactor", at + "/KHR_materials_specular", 3, 0, 1e3);
-        texture_info(*e, "specularTexture", at + "/KHR_materials_specular");
-        texture_info(*e, "specularColorTexture", at + "/KHR_materials_specular");
+        texture_info(*e, "specularTexture", at + "/KHR_materials_specular", true);
+        texture_info(*e, "specularColorTexture", at + "/KHR_materials_specular", true);
       }
+      if (const json* e = object(*ext, "KHR_materials_clearcoat", at)) {
+        const std::string c = at + "/KHR_materials_clearcoat";
+        number(*e, "clearcoatFactor", c, false, 0, 1);
+        number(*e, "clearcoatRoughnessFactor", c, false, 0, 1);
+        texture_info(*e, "clearcoatTexture", c, true);
+        texture_info(*e, "clearcoatRoughnessTexture", c, true);
+        texture_info(*e, "clearcoatNormalTexture", c);
+      }
+      if (const json* e = object(*ext, "KHR_materials_sheen", at)) {
+        const std::string s = at + "/KHR_materials_sheen";
+        numbers(*e, "sheenColorFactor", s, 3, 0, 1);
+        number(*e, "sheenRoughnessFactor", s, false, 0, 1);
+        texture_info(*e, "sheenColorTexture", s, true);
+        texture_info(*e, "sheenRoughnessTexture", s, true);
+      }
+      if (const json* e = object(*ext, "KHR_materials_volume", at)) {
+        const std::string v = at + "/KHR_materials_volume";
+        number(*e, "thicknessFactor", v, false, 0, HUGE_VAL);
+        if (number(*e, "attenuationDistance", v, false, 0, HUGE_VAL, 1) <= 0)
+          fail(v + "/attenuationDistance", "must be above 0");
+        numbers(*e, "attenuationColor", v, 3, 0, 1);
+        texture_info(*e, "thicknessTexture", v);
+      }
+      object(*ext, "KHR_materials_unlit", at);
       if (const json* e = object(*ext, "KHR_materials_ior", at)) {
         double ior = number(*e, "ior", at + "/KHR_materials_ior", false, 0, 1e3, 1.5);
         if (ior != 0 && ior < 1) fail(at + "/KHR_materials_ior/ior", "must be 0 or at least 1");

@@ -25,10 +25,10 @@ uint32_t read_u32(const std::string& b, size_t at) {
          uint32_t(uint8_t(b[at + 3])) << 24;
 }
 
-const char* const kSupportedExtensions[] = {"KHR_lights_punctual",        "KHR_materials_emissive_strength",
-                                            "KHR_materials_transmission", "KHR_materials_ior",
-                                            "KHR_materials_specular",     "KHR_texture_transform",
-                                            "KHR_mesh_quantization"};
+const char* const kSupportedExtensions[] = {
+    "KHR_lights_punctual",     "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
+    "KHR_materials_specular",  "KHR_materials_clearcoat",         "KHR_materials_sheen",        "KHR_materials_volume",
+    "KHR_materials_unlit",     "KHR_texture_transform",           "KHR_mesh_quantization"};
 
 bool supported_extension(const std::string& name) {
   for (const char* e : kSupportedExtensions)

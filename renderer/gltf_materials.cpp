@@ -127,6 +127,15 @@ TextureRef MaterialMaker::texture_ref(const tinygltf::TextureInfo& info, bool sr
   return texture_ref(info.index, info.texCoord, info.extensions, srgb, path);
 }
 
+TextureRef MaterialMaker::extension_texture(const tinygltf::Value& ext, const char* key, bool srgb, const std::string& path) {
+  if (!ext.Has(key)) return TextureRef();
+  const tinygltf::Value& info = ext.Get(key);
+  tinygltf::ExtensionMap extensions;  // the info's own, for KHR_texture_transform
+  if (info.Has("extensions") && info.Get("extensions").IsObject())
+    for (const std::string& name : info.Get("extensions").Keys()) extensions[name] = info.Get("extensions").Get(name);
+  return texture_ref(int(number(&info, "index", -1)), int(number(&info, "texCoord", 0)), extensions, srgb, path + "/" + key);
+}
+
 Material MaterialMaker::make(int index, bool vertex_color, const std::string& path) {
   static const tinygltf::Material kDefault;  // glTF's default material: white, metallic 1, roughness 1
   const tinygltf::Material& g = index >= 0 ? m_model.materials[size_t(index)] : kDefault;
@@ -149,8 +158,25 @@ Material MaterialMaker::make(int index, bool vertex_color, const std::string& pa
                                at + "/normalTexture");
     p.normal_scale = float(g.normalTexture.scale);
   }
-  if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty())
-    m_ctx.warn("alphaMode", at + "/alphaMode", "alphaMode " + clip(g.alphaMode) + " is not supported yet: surfaces render opaque");
+  p.alpha = pbr.baseColorFactor.size() >= 4 ? float(pbr.baseColorFactor[3]) : 1.0f;
+  if (g.alphaMode == "MASK") {
+    p.alpha_mode = AlphaMode::mask;
+    p.alpha_cutoff = float(g.alphaCutoff);
+    if (p.alpha_cutoff > 1)
+      m_ctx.warn("alphaCutoff", at + "/alphaCutoff", "alphaCutoff " + std::to_string(p.alpha_cutoff) +
+                                                         " is above 1: the whole surface is cut out");
+  } else if (g.alphaMode == "BLEND") {
+    p.alpha_mode = AlphaMode::blend;
+  } else if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty()) {
+    m_ctx.warn("alphaMode", at + "/alphaMode", "alphaMode " + clip(g.alphaMode) + " is none of OPAQUE, MASK and BLEND: "
+                                               "the surface renders opaque");
+  }
+  // Alpha that is 1 everywhere changes nothing: the surface stays opaque (and untested).
+  const bool alpha_texture = p.base_tex.used() && !m_desc.textures[size_t(p.base_tex.texture)].alpha.empty();
+  const bool constant_alpha = !alpha_texture && !vertex_color;
+  if ((p.alpha_mode == AlphaMode::blend && p.alpha >= 1 && constant_alpha) ||
+      (p.alpha_mode == AlphaMode::mask && p.alpha >= p.alpha_cutoff && constant_alpha))
+    p.alpha_mode = AlphaMode::opaque;
 
   // Emission: emissiveFactor x KHR_materials_emissive_strength (x the emissive texture per hit),
   // in our radiance units (docs/gltf.md).
@@ -164,22 +190,62 @@ Material MaterialMaker::make(int index, bool vertex_color, const std::string& pa
   p.ior = float(ior >= 1 ? ior : 1.5);  // 0 (a perfect reflector) is read as glTF's default
   if (const tinygltf::Value* t = extension(g.extensions, "KHR_materials_transmission")) {
     p.transmission = float(number(t, "transmissionFactor", 0));
-    if (t->Has("transmissionTexture") && p.transmission > 0) {
-      const tinygltf::Value& info = t->Get("transmissionTexture");
-      p.transmission_tex = texture_ref(int(number(&info, "index", -1)), int(number(&info, "texCoord", 0)),
-                                       tinygltf::ExtensionMap(), false, ext_at + "KHR_materials_transmission/transmissionTexture");
-    }
+    if (p.transmission > 0)
+      p.transmission_tex = extension_texture(*t, "transmissionTexture", false, ext_at + "KHR_materials_transmission");
   }
   if (const tinygltf::Value* s = extension(g.extensions, "KHR_materials_specular")) {
     p.specular = float(number(s, "specularFactor", 1));
     p.specular_color = color3(s, "specularColorFactor", Vec3(1.0f));
-    if (s->Has("specularTexture") || s->Has("specularColorTexture"))
-      m_ctx.warn("specular textures", ext_at + "KHR_materials_specular",
-                 "specular textures are not read yet: the factors apply");
+    p.specular_tex = extension_texture(*s, "specularTexture", false, ext_at + "KHR_materials_specular");  // alpha
+    p.specular_color_tex = extension_texture(*s, "specularColorTexture", true, ext_at + "KHR_materials_specular");
+  }
+  if (const tinygltf::Value* c = extension(g.extensions, "KHR_materials_clearcoat")) {
+    const std::string c_at = ext_at + "KHR_materials_clearcoat";
+    p.clearcoat = float(number(c, "clearcoatFactor", 0));
+    p.clearcoat_roughness = float(number(c, "clearcoatRoughnessFactor", 0));
+    if (p.clearcoat > 0) {
+      p.clearcoat_tex = extension_texture(*c, "clearcoatTexture", false, c_at);  // red
+      p.clearcoat_roughness_tex = extension_texture(*c, "clearcoatRoughnessTexture", false, c_at);  // green
+      if (c->Has("clearcoatNormalTexture"))
+        m_ctx.warn("clearcoat normal map", c_at + "/clearcoatNormalTexture",
+                   "the coat's own normal map is not read: the coat follows the base's shading normal");
+    }
+  }
+  if (const tinygltf::Value* s = extension(g.extensions, "KHR_materials_sheen")) {
+    const std::string s_at = ext_at + "KHR_materials_sheen";
+    p.sheen_color = color3(s, "sheenColorFactor", Vec3(0.0f));
+    p.sheen_roughness = float(number(s, "sheenRoughnessFactor", 0));
+    if (!is_black(p.sheen_color)) {
+      p.sheen_color_tex = extension_texture(*s, "sheenColorTexture", true, s_at);
+      p.sheen_roughness_tex = extension_texture(*s, "sheenRoughnessTexture", false, s_at);  // alpha
+    }
+  }
+  // KHR_materials_volume: Beer-Lambert absorption inside the mesh, sigma = -ln(colour) / distance;
+  // a thickness of 0 means a thin wall, which has no inside.
+  if (const tinygltf::Value* v = extension(g.extensions, "KHR_materials_volume")) {
+    const double distance = number(v, "attenuationDistance", 0);  // absent: infinite, nothing absorbed
+    if (number(v, "thicknessFactor", 0) > 0 && distance > 0 && std::isfinite(distance)) {
+      const Vec3 colour = color3(v, "attenuationColor", Vec3(1.0f));
+      for (int i = 0; i < 3; ++i)
+        p.attenuation[i] = float(-std::log(std::max(1e-6, double(colour[i]))) / distance);
+    }
+    if (v->Has("thicknessTexture"))
+      m_ctx.warn("thickness texture", ext_at + "KHR_materials_volume/thicknessTexture",
+                 "a path tracer measures the thickness the rays cross: the texture is not read");
+  }
+  // KHR_materials_unlit: the base colour, emitted and nothing reflected (docs/gltf.md).
+  if (extension(g.extensions, "KHR_materials_unlit")) {
+    p.unlit = true;
+    p.emissive = p.base;  // x the base colour texture and COLOR_0 per hit (textured_material)
+    p.base = Vec3(0.0f);
+    p.emissive_tex = TextureRef();
+    p.metal_rough_tex = p.normal_tex = TextureRef();
+    p.specular = 0, p.metallic = 0, p.transmission = 0, p.clearcoat = 0, p.sheen_color = Vec3(0.0f);
   }
   // Smooth untextured glass and metal are the exact delta BSDFs: the same light as the rough lobes
   // in the limit, and the light tracer renders their caustics.
-  const bool smooth_plain = ggx::alpha_of(p.roughness) <= ggx::kMinAlpha && !p.textured() && is_black(p.emissive);
+  const bool smooth_plain = ggx::alpha_of(p.roughness) <= ggx::kMinAlpha && !p.textured() && is_black(p.emissive) &&
+                            p.clearcoat <= 0 && is_black(p.sheen_color) && is_black(p.attenuation);
   const Vec3 base = max(Vec3(0.0f), min(Vec3(1.0f), p.base));
   if (smooth_plain && p.transmission >= 1 && p.metallic <= 0 && p.specular == 1 && p.specular_color == Vec3(1.0f)) {
     m.type = MaterialType::glass;

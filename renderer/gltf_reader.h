@@ -110,6 +110,8 @@ class MaterialMaker {
   Material make(int index, bool vertex_color, const std::string& path);
   TextureRef texture_ref(const tinygltf::TextureInfo& info, bool srgb, const std::string& path);
   TextureRef texture_ref(int texture, int tex_coord, const tinygltf::ExtensionMap& ext, bool srgb, const std::string& path);
+  // The texture info `key` of a material extension's object `ext` at `path`, or none.
+  TextureRef extension_texture(const tinygltf::Value& ext, const char* key, bool srgb, const std::string& path);
   int texture_for(int texture, bool srgb, const std::string& path);
   const TextureDesc* image_of(int texture, const std::string& path);
 

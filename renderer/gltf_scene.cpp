@@ -299,6 +299,12 @@ void Builder::add_primitive(const tinygltf::Primitive& prim, const Mat4& world, 
     same_count("COLOR_0", c.size() / size_t(n));
     mesh.colors.resize(nv);
     for (size_t v = 0; v < nv; ++v) mesh.colors[v] = Vec3(c[size_t(n) * v], c[size_t(n) * v + 1], c[size_t(n) * v + 2]);
+    bool translucent = false;  // COLOR_0's alpha multiplies the base colour's (glTF 2.0, 3.9.2)
+    for (size_t v = 0; n == 4 && pm.alpha_tested() && v < nv; ++v) translucent |= c[4 * v + 3] < 1;
+    if (translucent) {
+      mesh.color_alpha.resize(nv);
+      for (size_t v = 0; v < nv; ++v) mesh.color_alpha[v] = c[4 * v + 3];
+    }
   }
   if (pm.normal_tex.used()) add_tangents(mesh, attr("TANGENT"), attr(("TEXCOORD_" + std::to_string(pm.normal_tex.set)).c_str()) >= 0,
                                          pm.normal_tex.set, world, apath);

@@ -81,8 +81,8 @@ bool load_image(tinygltf::Image* image, const int index, std::string*, std::stri
     if (!bytes || size <= 0) throw std::runtime_error("the image is empty");
     TextureDesc t;
     t.name = image->name.empty() ? path : image->name;
-    t.texels = decode_image_rgb8(bytes, size_t(size), s.ctx->limits.max_texture_pixels, t.width, t.height);
-    s.texture_bytes += t.texels.size();
+    t.texels = decode_image_rgb8(bytes, size_t(size), s.ctx->limits.max_texture_pixels, t.width, t.height, &t.alpha);
+    s.texture_bytes += t.texels.size() + t.alpha.size();
     if (s.texture_bytes > s.ctx->limits.max_texture_bytes)
       throw std::runtime_error("the textures take more than " + std::to_string(s.ctx->limits.max_texture_bytes) +
                                " bytes decoded");

@@ -272,8 +272,17 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
   if constexpr ((F & kFeatTexture) != 0) file_material = &material_at(scene, *file_material, hit, ns);  // used within this call
   const Material& material = *file_material;
   Vec3 wo_world = -st.ray.d;
+  if constexpr ((F & kFeatTexture) != 0) {
+    // KHR_materials_volume: the segment just travelled lay inside the mesh (Beer-Lambert).
+    const Vec3 sigma = material.pbr.attenuation;
+    if (material.type == MaterialType::pbr && !is_black(sigma) && dot(st.ray.d, hit.ng) > 0) {
+      const float d = length(hit.p - st.ray.o);
+      st.beta = st.beta * Vec3(std::exp(-sigma.x * d), std::exp(-sigma.y * d), std::exp(-sigma.z * d));
+    }
+  }
   if (material.type == MaterialType::emission || (material.type == MaterialType::pbr && is_emissive(material))) {
     Vec3 le = emitted_radiance(material, Vec3(0, 0, dot(wo_world, hit.ng)));
+    if (material.type == MaterialType::pbr && material.pbr.unlit && bounce > 0) le = Vec3(0.0f);  // camera rays only
     bool light_traced = false;
     if constexpr ((F & kFeatDelta) != 0)
       light_traced = settings.caustics_light_traced && st.caustic_phase == 2 && hit.light >= 0;

@@ -1,7 +1,10 @@
 // The glTF metal-rough BSDF (pbr.h) and the GGX albedo tables its compensation reads (ggx.h).
 #include "pbr.h"
 
+#include <array>
+
 #include "ggx.h"
+#include "sheen.h"
 
 namespace pt {
 
@@ -43,6 +46,36 @@ float albedo_dielectric(float mu, float roughness, float eta) {
 
 }  // namespace ggx
 
+namespace sheen {
+
+float albedo(float mu, float roughness) {
+  constexpr int kMu = 32, kRough = 16, kSteps = 48;  // midpoint rule over cos(theta_i) and phi
+  static const std::array<float, kMu * kRough> table = [] {
+    std::array<float, kMu * kRough> t{};
+    for (int j = 0; j < kRough; ++j)
+      for (int i = 0; i < kMu; ++i) {
+        const float m = ggx::table_mu(i), alpha = alpha_of(float(j) / float(kRough - 1));
+        const Vec3 wo(std::sqrt(1 - m * m), 0, m);
+        double sum = 0;
+        for (int a = 0; a < kSteps; ++a)
+          for (int b = 0; b < kSteps; ++b) {
+            const float c = (float(a) + 0.5f) / kSteps, phi = kPi * (float(b) + 0.5f) / kSteps;  // phi in [0, pi]: symmetric
+            const float s = std::sqrt(1 - c * c);
+            sum += lobe(wo, Vec3(s * std::cos(phi), s * std::sin(phi), c), alpha) * c;
+          }
+        t[size_t(j * kMu + i)] = float(sum * 2 * kPi / (kSteps * kSteps));
+      }
+    return t;
+  }();
+  float fm, fr;
+  const int i = ggx::axis(std::sqrt(std::max(0.0f, mu)), kMu, fm), j = ggx::axis(roughness, kRough, fr);
+  const float a = table[size_t(j * kMu + i)] * (1 - fm) + table[size_t(j * kMu + i + 1)] * fm;
+  const float b = table[size_t((j + 1) * kMu + i)] * (1 - fm) + table[size_t((j + 1) * kMu + i + 1)] * fm;
+  return a * (1 - fr) + b * fr;
+}
+
+}  // namespace sheen
+
 namespace {
 
 // What every query at one wo needs: the lobes' weights and their Fresnel and compensation terms.
@@ -56,8 +89,14 @@ struct Lobes {
   Vec3 spec_comp;       // Turquin's 1 + F0 (1 - E) / E, specular layer
   Vec3 metal_comp;      // the same for the metal
   Vec3 metal_w, spec_w, diffuse_w, trans_w;  // each lobe's share of the material
-  float p_metal = 0, p_spec = 0, p_diffuse = 0, p_trans = 0;
+  float coat = 0, coat_alpha = 1, coat_comp = 1;  // KHR_materials_clearcoat
+  Vec3 sheen_w;                                   // KHR_materials_sheen: colour x what the coat leaves
+  float sheen_alpha = 1;
+  float p_metal = 0, p_spec = 0, p_diffuse = 0, p_trans = 0, p_coat = 0, p_sheen = 0;
 };
+
+// The clear coat's index (KHR_materials_clearcoat fixes it; Blender's importer sets the same).
+constexpr float kCoatEta = 1.5f;
 
 inline Vec3 lerp3(Vec3 a, Vec3 b, float t) { return a * (1 - t) + b * t; }
 
@@ -85,20 +124,46 @@ Lobes prepare(const PbrParams& p, Vec3 wo) {
   // The base sees what the layer leaves; one scalar for the three channels, as Cycles layers.
   const float below = clampf(1 - max_component(spec_albedo), 0, 1);
 
+  // The coat on top, then the sheen: each layer passes on what it does not reflect towards wo,
+  // 1 - its directional albedo (as Cycles layers its closures, and the extensions' albedo scaling).
+  float under = 1;
+  l.coat = clampf(p.clearcoat, 0, 1);
+  if (l.coat > 0) {
+    const float rc = clampf(p.clearcoat_roughness, 0, 1);
+    l.coat_alpha = ggx::alpha_of(rc);
+    l.coat_comp = 1 + ggx::fresnel(1, kCoatEta) * (1 / std::max(1e-4f, ggx::albedo_one(mu, rc)) - 1);
+    const float ec = std::min(1.0f, ggx::albedo_dielectric(mu, rc, kCoatEta) * l.coat_comp);
+    l.p_coat = l.coat * ec;
+    under = 1 - l.coat * ec;
+  }
+  const Vec3 sheen_color = max(Vec3(0.0f), min(Vec3(1.0f), p.sheen_color));
+  if (max_component(sheen_color) > 0) {
+    const float rs = clampf(p.sheen_roughness, 0, 1);
+    l.sheen_alpha = sheen::alpha_of(rs);
+    // Neubelt's visibility term is not energy-bounded: towards grazing a smooth sheen's albedo
+    // climbs to 3. Such a lobe is scaled to reflect all it receives, no more.
+    const float raw = sheen::albedo(mu, rs), es = std::min(1.0f, raw);
+    l.sheen_w = sheen_color * (under / std::max(1.0f, raw));
+    l.p_sheen = luminance(sheen_color) * es * under;
+    under *= 1 - max_component(sheen_color) * es;
+  }
+
   l.metal_comp = Vec3(1.0f) + base * (1 / e1 - 1);
-  l.metal_w = Vec3(metallic);
-  l.spec_w = Vec3((1 - metallic) * (1 - trans));
-  l.diffuse_w = base * ((1 - metallic) * (1 - trans) * below);
-  l.trans_w = Vec3((1 - metallic) * trans);
+  l.metal_w = Vec3(metallic * under);
+  l.spec_w = Vec3((1 - metallic) * (1 - trans) * under);
+  l.diffuse_w = base * ((1 - metallic) * (1 - trans) * below * under);
+  l.trans_w = Vec3((1 - metallic) * trans * under);
   // Expected weights towards wo pick the lobe to sample.
   const Vec3 metal_albedo = lerp3(base, Vec3(1.0f), ggx::schlick_weight(mu));
-  l.p_metal = metallic * luminance(metal_albedo);
-  l.p_spec = (1 - metallic) * (1 - trans) * luminance(spec_albedo);
+  l.p_metal = metallic * under * luminance(metal_albedo);
+  l.p_spec = (1 - metallic) * (1 - trans) * under * luminance(spec_albedo);
   l.p_diffuse = luminance(l.diffuse_w);
-  l.p_trans = (1 - metallic) * trans;
-  const float total = l.p_metal + l.p_spec + l.p_diffuse + l.p_trans;
+  l.p_trans = (1 - metallic) * trans * under;
+  const float total = l.p_metal + l.p_spec + l.p_diffuse + l.p_trans + l.p_coat + l.p_sheen;
   if (total > 0) {
-    l.p_metal /= total, l.p_spec /= total, l.p_diffuse /= total, l.p_trans /= total;
+    const float inv_total = 1 / total;
+    l.p_metal *= inv_total, l.p_spec *= inv_total, l.p_diffuse *= inv_total, l.p_trans *= inv_total;
+    l.p_coat *= inv_total, l.p_sheen *= inv_total;
   }
   return l;
 }
@@ -113,8 +178,20 @@ void opaque(const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
     f += l.diffuse_w * kInvPi;
     pdf += l.p_diffuse * wi.z * kInvPi;
   }
-  if (l.p_metal <= 0 && l.p_spec <= 0) return;
+  if (l.p_sheen > 0) {  // sampled as the diffuse lobe is
+    f += l.sheen_w * sheen::lobe(wo, wi, l.sheen_alpha);
+    pdf += l.p_sheen * wi.z * kInvPi;
+  }
   const Vec3 h = normalize(wo + wi);
+  if (l.p_coat > 0) {
+    const float dc = ggx::d(h, l.coat_alpha);
+    if (dc > 0) {
+      f += Vec3(l.coat * l.coat_comp * ggx::fresnel(dot(wo, h), kCoatEta) * dc * ggx::g2(wo, wi, l.coat_alpha) /
+                (4 * wo.z * wi.z));
+      pdf += l.p_coat * ggx::g1(wo, l.coat_alpha) * dc / (4 * wo.z);
+    }
+  }
+  if (l.p_metal <= 0 && l.p_spec <= 0) return;
   const float d = ggx::d(h, l.alpha);
   if (!(d > 0)) return;
   const float lobe = d * ggx::g2(wo, wi, l.alpha) / (4 * wo.z * wi.z);
@@ -185,7 +262,7 @@ float pbr_pdf(const PbrParams& p, Vec3 wo, Vec3 wi) {
 
 PbrLobeWeights pbr_lobe_weights(const PbrParams& p, Vec3 wo) {
   const Lobes l = prepare(p, wo);
-  return {l.p_metal, l.p_spec, l.p_diffuse, l.p_trans};
+  return {l.p_metal, l.p_spec, l.p_diffuse, l.p_trans, l.p_coat, l.p_sheen};
 }
 
 bool pbr_sample(const PbrParams& p, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s) {
@@ -195,15 +272,16 @@ bool pbr_sample(const PbrParams& p, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s
   const Vec3 wo_up = l.flip ? mirrored(wo) : wo;  // the opaque lobes' view
   Vec3 wi;
   float x = u_lobe;
-  if (x < l.p_diffuse) {
+  if (x < l.p_diffuse + l.p_sheen) {
     wi = sample_cosine_hemisphere(u);
     if (l.flip) wi = mirrored(wi);
-  } else if ((x -= l.p_diffuse) < l.p_metal + l.p_spec) {
-    wi = reflect(wo_up, ggx::sample_visible(wo_up, l.alpha, u));
+  } else if ((x -= l.p_diffuse + l.p_sheen) < l.p_metal + l.p_spec + l.p_coat) {
+    const float alpha = x < l.p_metal + l.p_spec ? l.alpha : l.coat_alpha;
+    wi = reflect(wo_up, ggx::sample_visible(wo_up, alpha, u));
     if (wi.z <= 0) return false;
     if (l.flip) wi = mirrored(wi);
   } else {
-    x -= l.p_metal + l.p_spec;
+    x -= l.p_metal + l.p_spec + l.p_coat;
     if (!(l.p_trans > 0)) return false;
     // Reflect or refract through a visible normal, in proportion to Fresnel (the remapped draw).
     const Vec3 h = ggx::sample_visible(wo, l.alpha, u);

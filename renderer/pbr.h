@@ -19,9 +19,9 @@ Vec3 pbr_eval(const PbrParams& p, Vec3 wo, Vec3 wi);
 float pbr_pdf(const PbrParams& p, Vec3 wo, Vec3 wi);
 bool pbr_sample(const PbrParams& p, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s);
 
-// The lobes' selection probabilities at wo (metal, specular, diffuse, transmission), for tests.
+// The lobes' selection probabilities at wo, for tests.
 struct PbrLobeWeights {
-  float metal = 0, specular = 0, diffuse = 0, transmission = 0;
+  float metal = 0, specular = 0, diffuse = 0, transmission = 0, coat = 0, sheen = 0;
 };
 PbrLobeWeights pbr_lobe_weights(const PbrParams& p, Vec3 wo);
 

@@ -130,7 +130,8 @@ SceneBase make_scene_base(const SceneDesc& desc) {
       if (!is_emissive(base.materials[mat])) continue;
       emitters = true;
       // A textured emitter is no light: hits find its radiance, light sampling could not.
-      if (base.materials[mat].type == MaterialType::pbr && base.materials[mat].pbr.emissive_tex.used()) continue;
+      // So is one with alpha (rays may pass what light sampling finds) and an unlit one.
+      if (base.materials[mat].type == MaterialType::pbr && base.materials[mat].pbr.emission_found_by_hits()) continue;
       const uint32_t* vi = &mesh.indices[3 * t];
       if (!(length(cross(mesh.positions[vi[1]] - mesh.positions[vi[0]], mesh.positions[vi[2]] - mesh.positions[vi[0]])) > 0))
         continue;  // a zero-area triangle cannot emit
@@ -165,8 +166,6 @@ SceneBase make_scene_base(const SceneDesc& desc) {
     l.triangle_distribution = Distribution1D(areas);
     light_kinds.insert("mesh");
   }
-
-  base.accel = std::make_shared<const Accel>(desc, panels, mesh_light);
 
   SceneFeatures& f = base.features;
   std::set<std::string> mats;
@@ -210,6 +209,12 @@ SceneBase make_scene_base(const SceneDesc& desc) {
     base.textures = std::make_shared<const std::vector<TextureDesc>>(desc.textures);
     f.textures = desc.textures.size();
   }
+  CoverageTest coverage;  // alpha-tested glTF materials: their textures and factors decide each hit
+  if (base.textures)
+    coverage = [textures = base.textures, materials = base.materials](int m, const HitAttributes& at, float u) {
+      return alpha_covers(*textures, materials[size_t(m)].pbr, at, u);
+    };
+  base.accel = std::make_shared<const Accel>(desc, panels, mesh_light, std::move(coverage));
   if (pbr || f.textured) f.bits = kFeatAll;  // glTF materials take the generic loop (path_tracer_for)
   base.default_light = desc.default_light && !emitters;
   base.triangle_count = desc.triangle_count();

@@ -102,6 +102,11 @@ struct RenderScene {
 // stay as small as without textures.
 const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit, Vec3& ns);
 
+// Whether a ray stops at a hit on an alpha-tested material (PbrParams::alpha_tested): MASK keeps
+// alpha at or above the cutoff, BLEND keeps the hit with probability alpha (u uniform in [0, 1)).
+// Alpha is baseColorFactor's x the base colour texture's x COLOR_0's (glTF 2.0, 3.9.4).
+bool alpha_covers(const std::vector<TextureDesc>& textures, const PbrParams& p, const HitAttributes& at, float u);
+
 // The material a path sees at a hit: `m`, or textured_material for a textured one.
 inline const Material& material_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit, Vec3& ns) {
   return __builtin_expect(m.textured(), 0) ? textured_material(scene, m, hit, ns) : m;

@@ -25,6 +25,10 @@ struct TextureRef {
   bool used() const { return texture >= 0; }
 };
 
+// glTF alphaMode: opaque, cut out below a cutoff, or blended (rendered as stochastic
+// pass-through: a ray passes a surface of alpha a with probability 1 - a).
+enum class AlphaMode { opaque, mask, blend };
+
 // glTF 2.0's metal-rough material with the extensions read (docs/gltf.md): the factors, and the
 // textures that multiply them at each hit (material_at). Plain data: a hit's copy is cheap.
 struct PbrParams {
@@ -36,15 +40,37 @@ struct PbrParams {
   float transmission = 0;                  // KHR_materials_transmission
   Vec3 emissive{0, 0, 0};                  // emissiveFactor x KHR_materials_emissive_strength
   float normal_scale = 1;
+  float clearcoat = 0, clearcoat_roughness = 0;  // KHR_materials_clearcoat
+  Vec3 sheen_color{0, 0, 0};                     // KHR_materials_sheen
+  float sheen_roughness = 0;
+  Vec3 attenuation{0, 0, 0};  // KHR_materials_volume: absorption per unit length inside the mesh
+  bool unlit = false;         // KHR_materials_unlit: `emissive` holds the base colour, seen by camera rays
   bool vertex_color = false;               // the mesh's COLOR_0 multiplies the base colour
   bool double_sided = false;               // doubleSided: emission leaves both faces
+  AlphaMode alpha_mode = AlphaMode::opaque;
+  float alpha = 1;                         // baseColorFactor's alpha (x the texture's x COLOR_0's)
+  float alpha_cutoff = 0.5f;               // MASK: alpha below it is cut out
   TextureRef base_tex, metal_rough_tex, emissive_tex, normal_tex, transmission_tex;
+  TextureRef specular_tex, specular_color_tex, clearcoat_tex, clearcoat_roughness_tex, sheen_color_tex,
+      sheen_roughness_tex;
   // Every texture slot, for what looks at them all (the loader's uv sets, the mesh checks).
-  std::array<const TextureRef*, 5> texture_refs() const {
-    return {&base_tex, &metal_rough_tex, &emissive_tex, &normal_tex, &transmission_tex};
+  std::array<const TextureRef*, 11> texture_refs() const {
+    return {&base_tex,     &metal_rough_tex,    &emissive_tex,  &normal_tex,
+            &transmission_tex, &specular_tex,   &specular_color_tex, &clearcoat_tex,
+            &clearcoat_roughness_tex, &sheen_color_tex, &sheen_roughness_tex};
   }
+  std::array<TextureRef*, 11> texture_refs() {
+    const auto c = const_cast<const PbrParams*>(this)->texture_refs();
+    std::array<TextureRef*, 11> out;
+    for (size_t i = 0; i < c.size(); ++i) out[i] = const_cast<TextureRef*>(c[i]);
+    return out;
+  }
+  // Emission that light sampling cannot know: textured, cut out by alpha, or seen by camera rays
+  // only (unlit). Such emitters are found by the rays that hit them, never registered as lights.
+  bool emission_found_by_hits() const { return emissive_tex.used() || alpha_tested() || unlit; }
+  bool alpha_tested() const { return alpha_mode != AlphaMode::opaque; }
   bool textured() const {
-    bool any = vertex_color;
+    bool any = vertex_color || alpha_tested();
     for (const TextureRef* r : texture_refs()) any |= r->used();
     return any;
   }
@@ -75,6 +101,7 @@ struct TextureDesc {
   std::string name;
   int width = 0, height = 0;
   std::vector<uint8_t> texels;  // 3 bytes a texel
+  std::vector<uint8_t> alpha;   // 1 byte a texel (linear), or empty: opaque
   bool srgb = true;
   TextureWrap wrap_s = TextureWrap::repeat, wrap_t = TextureWrap::repeat;
   bool nearest = false;
@@ -116,6 +143,7 @@ struct MeshDesc {
   std::vector<Vec2> uvs;           // per-vertex texture coordinates (TEXCOORD_0), or empty
   std::vector<Vec2> uvs1;          // TEXCOORD_1, or empty
   std::vector<Vec3> colors;        // per-vertex linear RGB colours, or empty
+  std::vector<float> color_alpha;  // COLOR_0's alpha per vertex, or empty (opaque; read for alpha-tested materials)
   // Per-vertex tangents for normal maps (xyz, w = the bitangent's sign), world space, or empty.
   std::vector<std::array<float, 4>> tangents;
 };

@@ -38,8 +38,12 @@ inline int wrap(int i, int n, TextureWrap mode) {
   return 0;
 }
 
+inline size_t texel_index(const TextureDesc& t, int x, int y) {
+  return size_t(wrap(y, t.height, t.wrap_t)) * size_t(t.width) + size_t(wrap(x, t.width, t.wrap_s));
+}
+
 inline Vec3 texel(const TextureDesc& t, int x, int y) {
-  const uint8_t* p = &t.texels[3 * (size_t(wrap(y, t.height, t.wrap_t)) * size_t(t.width) + size_t(wrap(x, t.width, t.wrap_s)))];
+  const uint8_t* p = &t.texels[3 * texel_index(t, x, y)];
   if (!t.srgb) return Vec3(p[0], p[1], p[2]) * (1 / 255.0f);  // data: linear
   const auto& lut = srgb_table();
   return Vec3(lut[p[0]], lut[p[1]], lut[p[2]]);
@@ -56,17 +60,28 @@ uint8_t linear_to_srgb8(float v) {
   return uint8_t(std::lround(255 * s));
 }
 
-Vec3 eval_texture(const TextureDesc& t, Vec2 uv) {
-  if (t.width <= 0 || t.height <= 0 || t.texels.size() < 3 * size_t(t.width) * size_t(t.height)) return Vec3(1.0f);
+// `fetch(x, y)` at uv, bilinear between texel centres unless the texture is `nearest`.
+template <class Fetch>
+auto filter(const TextureDesc& t, Vec2 uv, Fetch fetch) {
   // Far-out or non-finite coordinates would overflow the texel index: read them at 0.
   float u = std::isfinite(uv.x) && std::fabs(uv.x) < 1e6f ? uv.x : 0.0f;
   float v = std::isfinite(uv.y) && std::fabs(uv.y) < 1e6f ? uv.y : 0.0f;
   float fx = u * t.width - 0.5f, fy = v * t.height - 0.5f;  // texel centres at half-integers
-  if (t.nearest) return texel(t, int(std::floor(fx + 0.5f)), int(std::floor(fy + 0.5f)));
+  if (t.nearest) return fetch(int(std::floor(fx + 0.5f)), int(std::floor(fy + 0.5f)));
   int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
   float tx = fx - float(x0), ty = fy - float(y0);
-  return (texel(t, x0, y0) * (1 - tx) + texel(t, x0 + 1, y0) * tx) * (1 - ty) +
-         (texel(t, x0, y0 + 1) * (1 - tx) + texel(t, x0 + 1, y0 + 1) * tx) * ty;
+  return (fetch(x0, y0) * (1 - tx) + fetch(x0 + 1, y0) * tx) * (1 - ty) +
+         (fetch(x0, y0 + 1) * (1 - tx) + fetch(x0 + 1, y0 + 1) * tx) * ty;
+}
+
+Vec3 eval_texture(const TextureDesc& t, Vec2 uv) {
+  if (t.width <= 0 || t.height <= 0 || t.texels.size() < 3 * size_t(t.width) * size_t(t.height)) return Vec3(1.0f);
+  return filter(t, uv, [&](int x, int y) { return texel(t, x, y); });
+}
+
+float eval_texture_alpha(const TextureDesc& t, Vec2 uv) {
+  if (t.width <= 0 || t.height <= 0 || t.alpha.size() < size_t(t.width) * size_t(t.height)) return 1.0f;
+  return filter(t, uv, [&](int x, int y) { return float(t.alpha[texel_index(t, x, y)]) * (1 / 255.0f); });
 }
 
 Vec3 texture_mean(const TextureDesc& t) {

@@ -19,6 +19,9 @@ uint8_t linear_to_srgb8(float v);
 // says; bilinear unless `nearest`.
 Vec3 eval_texture(const TextureDesc& texture, Vec2 uv);
 
+// The texture's alpha at uv, filtered as eval_texture filters colour; 1 where it has none.
+float eval_texture_alpha(const TextureDesc& texture, Vec2 uv);
+
 // The mean linear colour of a texture: what materials without per-hit texturing use of it.
 Vec3 texture_mean(const TextureDesc& texture);
 

@@ -8,13 +8,22 @@ namespace pt {
 
 namespace {
 
-Vec3 lookup(const RenderScene& scene, const TextureRef& ref, const HitAttributes& at) {
+Vec2 texture_uv(const TextureRef& ref, const HitAttributes& at) {
   Vec2 uv = at.uv[ref.set == 1 ? 1 : 0];
   if (ref.transformed) {
     const float* m = ref.m;
     uv = Vec2{m[0] * uv.x + m[1] * uv.y + m[2], m[3] * uv.x + m[4] * uv.y + m[5]};
   }
-  return eval_texture((*scene.textures)[size_t(ref.texture)], uv);
+  return uv;
+}
+
+Vec3 lookup(const RenderScene& scene, const TextureRef& ref, const HitAttributes& at) {
+  return eval_texture((*scene.textures)[size_t(ref.texture)], texture_uv(ref, at));
+}
+
+// The alpha channel, which specularTexture and sheenRoughnessTexture read.
+float alpha_lookup(const RenderScene& scene, const TextureRef& ref, const HitAttributes& at) {
+  return eval_texture_alpha((*scene.textures)[size_t(ref.texture)], texture_uv(ref, at));
 }
 
 // The shading normal bent by a tangent-space normal n_t (components in [-1, 1], x and y scaled):
@@ -29,6 +38,18 @@ Vec3 bend(Vec3 ns, const HitAttributes& at, Vec3 n_t) {
 
 }  // namespace
 
+bool alpha_covers(const std::vector<TextureDesc>& textures, const PbrParams& p, const HitAttributes& at, float u) {
+  float alpha = p.alpha * at.alpha;
+  if (p.base_tex.used() && size_t(p.base_tex.texture) < textures.size())
+    alpha *= eval_texture_alpha(textures[size_t(p.base_tex.texture)], texture_uv(p.base_tex, at));
+  switch (p.alpha_mode) {
+    case AlphaMode::opaque: return true;
+    case AlphaMode::mask: return alpha >= p.alpha_cutoff;
+    case AlphaMode::blend: return u < alpha;
+  }
+  return true;
+}
+
 [[gnu::noinline]] const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit,
                                                     Vec3& ns) {
   thread_local Material scratch;
@@ -36,11 +57,12 @@ Vec3 bend(Vec3 ns, const HitAttributes& at, Vec3 n_t) {
   PbrParams& p = scratch.pbr;
   scratch.type = MaterialType::pbr;
   p = in;
-  p.base_tex = p.metal_rough_tex = p.emissive_tex = p.normal_tex = p.transmission_tex = TextureRef();
+  for (TextureRef* r : p.texture_refs()) *r = TextureRef();
   p.vertex_color = false;
   const HitAttributes at = scene.accel->attributes(hit);
-  if (in.base_tex.used()) p.base = p.base * lookup(scene, in.base_tex, at);
-  if (in.vertex_color) p.base = p.base * at.color;
+  Vec3& base = in.unlit ? p.emissive : p.base;  // unlit: the base colour is emitted
+  if (in.base_tex.used()) base = base * lookup(scene, in.base_tex, at);
+  if (in.vertex_color) base = base * at.color;
   if (in.metal_rough_tex.used()) {  // roughness in G, metalness in B
     const Vec3 mr = lookup(scene, in.metal_rough_tex, at);
     p.roughness *= mr.y;
@@ -48,6 +70,12 @@ Vec3 bend(Vec3 ns, const HitAttributes& at, Vec3 n_t) {
   }
   if (in.emissive_tex.used()) p.emissive = p.emissive * lookup(scene, in.emissive_tex, at);
   if (in.transmission_tex.used()) p.transmission *= lookup(scene, in.transmission_tex, at).x;
+  if (in.specular_tex.used()) p.specular *= alpha_lookup(scene, in.specular_tex, at);
+  if (in.specular_color_tex.used()) p.specular_color = p.specular_color * lookup(scene, in.specular_color_tex, at);
+  if (in.clearcoat_tex.used()) p.clearcoat *= lookup(scene, in.clearcoat_tex, at).x;
+  if (in.clearcoat_roughness_tex.used()) p.clearcoat_roughness *= lookup(scene, in.clearcoat_roughness_tex, at).y;
+  if (in.sheen_color_tex.used()) p.sheen_color = p.sheen_color * lookup(scene, in.sheen_color_tex, at);
+  if (in.sheen_roughness_tex.used()) p.sheen_roughness *= alpha_lookup(scene, in.sheen_roughness_tex, at);
   if (in.normal_tex.used()) {
     const Vec3 c = lookup(scene, in.normal_tex, at);
     Vec3 n_t = c * 2.0f - Vec3(1.0f);

@@ -185,3 +185,46 @@ TEST(GltfTextures, NormalMapsTiltTheShadingNormalInTheTangentFrame) {
     }
   }
 }
+
+// The extensions' textures are read per hit as the core ones are: the clear coat's strength (red),
+// the sheen's colour and the specular colour, quarter by quarter against constant factors.
+TEST(GltfTextures, ExtensionTexturesAreReadPerHit) {
+  const std::vector<uint8_t> texels = {255, 0, 0, 128, 0, 0, 40, 0, 0, 0, 0, 0};  // red: 1, 0.5, 0.16, 0 (linear)
+  const std::vector<uint8_t> colours = {230, 40, 40, 40, 230, 40, 40, 40, 230, 200, 200, 200};
+  struct Case {
+    const char* name;
+    const char* extension;
+    json textured, constant;  // the extension's object; `constant` takes the texel's value for "@"
+    bool colour;
+  };
+  const Case cases[] = {
+      {"clearcoat", "KHR_materials_clearcoat", {{"clearcoatFactor", 1}, {"clearcoatTexture", {{"index", 0}}}},
+       {{"clearcoatFactor", "@"}}, false},
+      {"sheen colour", "KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}, {"sheenRoughnessFactor", 0.4}, {"sheenColorTexture", {{"index", 0}}}},
+       {{"sheenColorFactor", "@"}, {"sheenRoughnessFactor", 0.4}}, true},
+      {"specular colour", "KHR_materials_specular", {{"specularColorFactor", {1, 1, 1}}, {"specularColorTexture", {{"index", 0}}}},
+       {{"specularColorFactor", "@"}}, true},
+  };
+  for (const Case& k : cases) {
+    const std::vector<uint8_t>& t = k.colour ? colours : texels;
+    auto doc = [&](const json& ext) {
+      GltfDoc g = textured_quad();
+      g.doc["materials"][0]["pbrMetallicRoughness"] = {{"baseColorFactor", {0.02, 0.02, 0.02, 1}}, {"metallicFactor", 0},
+                                                       {"roughnessFactor", 0.5}};
+      g.doc["materials"][0]["extensions"][k.extension] = ext;
+      return g;
+    };
+    GltfDoc g = doc(k.textured);
+    add_texture(g, t);
+    const ImageRGB img = render(g.text(), 64, 2);
+    expect_quarters_match(img, [&](int q) {
+      json ext = k.constant;
+      for (auto& [key, value] : ext.items())
+        if (value == "@") {
+          if (k.colour) value = {srgb8_to_linear(t[size_t(3 * q)]), srgb8_to_linear(t[size_t(3 * q + 1)]), srgb8_to_linear(t[size_t(3 * q + 2)])};
+          else value = t[size_t(3 * q)] / 255.0;
+        }
+      return doc(ext).text();
+    }, 64, 2, k.name);
+  }
+}

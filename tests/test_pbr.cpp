@@ -32,6 +32,18 @@ PbrParams params(Vec3 base, float metallic, float roughness, float transmission 
   return p;
 }
 
+PbrParams coated(PbrParams p, float coat, float roughness) {
+  p.clearcoat = coat;
+  p.clearcoat_roughness = roughness;
+  return p;
+}
+
+PbrParams sheened(PbrParams p, Vec3 colour, float roughness) {
+  p.sheen_color = colour;
+  p.sheen_roughness = roughness;
+  return p;
+}
+
 struct Case {
   std::string name;
   PbrParams p;
@@ -39,8 +51,8 @@ struct Case {
 void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 std::string case_name(const testing::TestParamInfo<Case>& info) { return info.param.name; }
 
-// Each lobe alone, then mixes: a plastic (specular over diffuse), a half metal, rough glass, and
-// everything at once.
+// Each lobe alone, then mixes: a plastic (specular over diffuse), a half metal, rough glass,
+// everything at once, and the clear coat and sheen layers over them.
 std::vector<Case> cases() {
   return {
       {"Metal", params({0.9f, 0.6f, 0.3f}, 1, 0.5f)},
@@ -51,6 +63,10 @@ std::vector<Case> cases() {
       {"RoughGlass", params({1, 1, 1}, 0, 0.5f, 1)},
       {"DenseRoughGlass", params({0.9f, 1, 0.8f}, 0, 0.7f, 1, 2.4f)},
       {"Everything", params({0.7f, 0.5f, 0.3f}, 0.3f, 0.6f, 0.5f)},
+      {"CoatedPlastic", coated(params({0.2f, 0.4f, 0.8f}, 0, 0.5f), 1, 0.35f)},
+      {"CoatedMetal", coated(params({0.9f, 0.6f, 0.3f}, 1, 0.6f), 0.7f, 0.3f)},
+      {"Sheen", sheened(params({0.3f, 0.1f, 0.1f}, 0, 0.8f), {0.8f, 0.6f, 0.4f}, 0.5f)},
+      {"CoatSheenGlass", coated(sheened(params({0.7f, 0.5f, 0.3f}, 0.3f, 0.6f, 0.5f), Vec3(0.5f), 0.3f), 0.5f, 0.2f)},
   };
 }
 

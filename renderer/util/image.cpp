@@ -145,8 +145,10 @@ std::string encode_exr(const ImageRGB& img, const Metadata& meta) { return modul
 
 ImageRGB read_image(const std::string& path) { return module().read_image(path); }
 
-std::vector<uint8_t> decode_image_rgb8(const uint8_t* data, size_t size, size_t max_pixels, int& width, int& height) {
-  return module().decode_rgb8(data, size, max_pixels, &width, &height);
+std::vector<uint8_t> decode_image_rgb8(const uint8_t* data, size_t size, size_t max_pixels, int& width, int& height,
+                                       std::vector<uint8_t>* alpha) {
+  std::vector<uint8_t> ignored;
+  return module().decode_rgb8(data, size, max_pixels, &width, &height, alpha ? alpha : &ignored);
 }
 
 std::string check_image_file(const std::string& path, int width, int height) {

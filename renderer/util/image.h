@@ -53,9 +53,12 @@ std::string encode_exr(const ImageRGB& img, const Metadata& meta = {});
 // Reads any image OpenImageIO can read as linear RGB float (top row first); throws on failure.
 ImageRGB read_image(const std::string& path);
 // Decodes a PNG or JPEG held in memory (recognised by its signature) as 8-bit RGB, top row first:
-// grey is replicated, alpha dropped, 16-bit samples rounded. An image of more than max_pixels is
-// refused from its header, before its pixels are decoded. Throws std::runtime_error saying why.
-std::vector<uint8_t> decode_image_rgb8(const uint8_t* data, size_t size, size_t max_pixels, int& width, int& height);
+// grey is replicated, 16-bit samples rounded. An image of more than max_pixels is refused from its
+// header, before its pixels are decoded. Throws std::runtime_error saying why. `alpha`, when
+// given, receives the alpha channel (one byte a texel), or stays empty when the image has none or
+// every texel is opaque.
+std::vector<uint8_t> decode_image_rgb8(const uint8_t* data, size_t size, size_t max_pixels, int& width, int& height,
+                                       std::vector<uint8_t>* alpha = nullptr);
 // Empty when the image file reads back whole as a width x height image (a PNG also ends with its
 // IEND chunk), else what is wrong with it. Files written by write_image are checked so before
 // they take their name; this checks files written earlier.

@@ -14,7 +14,7 @@
 namespace pt {
 
 // Bumped whenever the table below changes, so a stale module is refused by name, not called.
-constexpr uint32_t kImageModuleAbi = 4;
+constexpr uint32_t kImageModuleAbi = 5;
 
 struct ImageModule {
   uint32_t abi;
@@ -30,8 +30,9 @@ struct ImageModule {
   std::string (*writer_problem)(const std::string& path);
   // Empty when the file reads back whole as a width x height image, else what is wrong.
   std::string (*check_image_file)(const std::string& path, int width, int height);
-  // A PNG or JPEG in memory as 8-bit RGB (top row first); see decode_image_rgb8 in image.h.
-  std::vector<uint8_t> (*decode_rgb8)(const uint8_t* data, size_t size, size_t max_pixels, int* width, int* height);
+  // A PNG or JPEG in memory as 8-bit RGB (top row first) and its alpha; see decode_image_rgb8 in image.h.
+  std::vector<uint8_t> (*decode_rgb8)(const uint8_t* data, size_t size, size_t max_pixels, int* width, int* height,
+                                      std::vector<uint8_t>* alpha);
 };
 
 }  // namespace pt

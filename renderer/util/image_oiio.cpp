@@ -189,7 +189,8 @@ std::string check_image_file(const std::string& path, int width, int height) {
   return read_back(path, is_png(path), width, height, 3, OIIO::TypeDesc::FLOAT, nullptr);
 }
 
-std::vector<uint8_t> decode_rgb8(const uint8_t* data, size_t size, size_t max_pixels, int* width, int* height) {
+std::vector<uint8_t> decode_rgb8(const uint8_t* data, size_t size, size_t max_pixels, int* width, int* height,
+                                 std::vector<uint8_t>* alpha) {
   // The signature decides the decoder (glTF 2.0 core images are PNG or JPEG), not a MIME type.
   static const uint8_t png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'}, jpeg[3] = {0xff, 0xd8, 0xff};
   const char* name = nullptr;
@@ -225,6 +226,16 @@ std::vector<uint8_t> decode_rgb8(const uint8_t* data, size_t size, size_t max_pi
   std::vector<uint8_t> rgb(size_t(pixels) * 3);
   for (size_t i = 0; i < size_t(pixels); ++i)
     for (int c = 0; c < 3; ++c) rgb[3 * i + size_t(c)] = raw[i * size_t(nc) + size_t(nc >= 3 ? c : 0)];
+  alpha->clear();
+  const int ac = spec.alpha_channel >= 0 ? spec.alpha_channel : nc == 2 || nc == 4 ? nc - 1 : -1;
+  if (ac >= 3 || (ac >= 1 && nc == 2)) {
+    bool opaque = true;
+    for (size_t i = 0; i < size_t(pixels) && opaque; ++i) opaque = raw[i * size_t(nc) + size_t(ac)] == 255;
+    if (!opaque) {
+      alpha->resize(size_t(pixels));
+      for (size_t i = 0; i < size_t(pixels); ++i) (*alpha)[i] = raw[i * size_t(nc) + size_t(ac)];
+    }
+  }
   *width = spec.width;
   *height = spec.height;
   return rgb;
