@@ -144,9 +144,10 @@ bool sample_light(const Light& light, Vec3 p, Vec2 u, LightSample& s) {
         float c = dot(-s.wi, light.direction);
         if (c < light.cos_cutoff) return false;
         falloff = light.exponent > 0 ? std::pow(std::max(c, 0.0f), light.exponent) : 1.0f;
-        if (light.cos_inner <= 1) {  // KHR_lights_punctual's recommended smooth edge
-          float t = clampf((c - light.cos_cutoff) / std::max(1e-3f, light.cos_inner - light.cos_cutoff), 0.0f, 1.0f);
-          falloff *= t * t;
+        const float t = c - light.cos_cutoff;
+        if (t < light.spot_smooth) {  // glTF: Cycles' smoothstep edge (docs/gltf.md)
+          const float x = t / light.spot_smooth;
+          falloff *= x * x * (3 - 2 * x);
         }
       }
       s.radiance = light.color * (falloff / dist2);

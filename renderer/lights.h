@@ -42,7 +42,9 @@ struct Light {
   float area = 0;        // rect and mesh
   float cos_cutoff = -1; // spot: cosine of the half angle
   float exponent = 0;    // spot fall-off exponent
-  float cos_inner = 2;   // spot: cosine of the full-intensity cone's half angle (glTF); > 1: none
+  // glTF spot: the width, in cos(theta), of the edge band where the intensity rises as a smoothstep
+  // from the cone's edge (Blender's spot_blend, as its glTF importer sets it); 0: a hard edge.
+  float spot_smooth = 0;
   bool sphere = false;   // ambient: every direction, not only the +Y hemisphere (the default light)
   bool two_sided = false;  // mesh: both faces emit (a double-sided glTF emitter)
   std::vector<Vec3> triangles;  // mesh: three corners per triangle, world space

@@ -1,8 +1,6 @@
 // The glTF metal-rough BSDF (pbr.h) and the GGX albedo tables its compensation reads (ggx.h).
 #include "pbr.h"
 
-#include <array>
-
 #include "ggx.h"
 #include "sheen.h"
 
@@ -46,36 +44,6 @@ float albedo_dielectric(float mu, float roughness, float eta) {
 
 }  // namespace ggx
 
-namespace sheen {
-
-float albedo(float mu, float roughness) {
-  constexpr int kMu = 32, kRough = 16, kSteps = 48;  // midpoint rule over cos(theta_i) and phi
-  static const std::array<float, kMu * kRough> table = [] {
-    std::array<float, kMu * kRough> t{};
-    for (int j = 0; j < kRough; ++j)
-      for (int i = 0; i < kMu; ++i) {
-        const float m = ggx::table_mu(i), alpha = alpha_of(float(j) / float(kRough - 1));
-        const Vec3 wo(std::sqrt(1 - m * m), 0, m);
-        double sum = 0;
-        for (int a = 0; a < kSteps; ++a)
-          for (int b = 0; b < kSteps; ++b) {
-            const float c = (float(a) + 0.5f) / kSteps, phi = kPi * (float(b) + 0.5f) / kSteps;  // phi in [0, pi]: symmetric
-            const float s = std::sqrt(1 - c * c);
-            sum += lobe(wo, Vec3(s * std::cos(phi), s * std::sin(phi), c), alpha) * c;
-          }
-        t[size_t(j * kMu + i)] = float(sum * 2 * kPi / (kSteps * kSteps));
-      }
-    return t;
-  }();
-  float fm, fr;
-  const int i = ggx::axis(std::sqrt(std::max(0.0f, mu)), kMu, fm), j = ggx::axis(roughness, kRough, fr);
-  const float a = table[size_t(j * kMu + i)] * (1 - fm) + table[size_t(j * kMu + i + 1)] * fm;
-  const float b = table[size_t((j + 1) * kMu + i)] * (1 - fm) + table[size_t((j + 1) * kMu + i + 1)] * fm;
-  return a * (1 - fr) + b * fr;
-}
-
-}  // namespace sheen
-
 namespace {
 
 // What every query at one wo needs: the lobes' weights and their Fresnel and compensation terms.
@@ -90,8 +58,8 @@ struct Lobes {
   Vec3 metal_comp;      // the same for the metal
   Vec3 metal_w, spec_w, diffuse_w, trans_w;  // each lobe's share of the material
   float coat = 0, coat_alpha = 1, coat_comp = 1;  // KHR_materials_clearcoat
-  Vec3 sheen_w;                                   // KHR_materials_sheen: colour x what the coat leaves
-  float sheen_alpha = 1;
+  Vec3 sheen_w;                                   // KHR_materials_sheen: colour x albedo x what the coat leaves
+  sheen::Ltc sheen_ltc;
   float p_metal = 0, p_spec = 0, p_diffuse = 0, p_trans = 0, p_coat = 0, p_sheen = 0;
 };
 
@@ -99,6 +67,7 @@ struct Lobes {
 constexpr float kCoatEta = 1.5f;
 
 inline Vec3 lerp3(Vec3 a, Vec3 b, float t) { return a * (1 - t) + b * t; }
+inline Vec3 mirrored(Vec3 w) { return Vec3(w.x, w.y, -w.z); }
 
 Lobes prepare(const PbrParams& p, Vec3 wo) {
   Lobes l;
@@ -138,12 +107,10 @@ Lobes prepare(const PbrParams& p, Vec3 wo) {
   }
   const Vec3 sheen_color = max(Vec3(0.0f), min(Vec3(1.0f), p.sheen_color));
   if (max_component(sheen_color) > 0) {
-    const float rs = clampf(p.sheen_roughness, 0, 1);
-    l.sheen_alpha = sheen::alpha_of(rs);
-    // Neubelt's visibility term is not energy-bounded: towards grazing a smooth sheen's albedo
-    // climbs to 3. Such a lobe is scaled to reflect all it receives, no more.
-    const float raw = sheen::albedo(mu, rs), es = std::min(1.0f, raw);
-    l.sheen_w = sheen_color * (under / std::max(1.0f, raw));
+    const Vec3 wo_up = l.flip ? mirrored(wo) : wo;
+    l.sheen_ltc = sheen::ltc(wo_up, p.sheen_roughness);
+    const float es = sheen::albedo(mu, p.sheen_roughness);
+    l.sheen_w = sheen_color * (es * under);
     l.p_sheen = luminance(sheen_color) * es * under;
     under *= 1 - max_component(sheen_color) * es;
   }
@@ -168,8 +135,6 @@ Lobes prepare(const PbrParams& p, Vec3 wo) {
   return l;
 }
 
-inline Vec3 mirrored(Vec3 w) { return Vec3(w.x, w.y, -w.z); }
-
 // The opaque lobes (metal, specular, diffuse) for wo, wi both above the surface: f and the
 // mixture's pdf share.
 void opaque(const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
@@ -178,9 +143,10 @@ void opaque(const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
     f += l.diffuse_w * kInvPi;
     pdf += l.p_diffuse * wi.z * kInvPi;
   }
-  if (l.p_sheen > 0) {  // sampled as the diffuse lobe is
-    f += l.sheen_w * sheen::lobe(wo, wi, l.sheen_alpha);
-    pdf += l.p_sheen * wi.z * kInvPi;
+  if (l.p_sheen > 0) {  // f cos = colour x albedo x D
+    const float d = sheen::density(l.sheen_ltc, wi);
+    f += l.sheen_w * (d / wi.z);
+    pdf += l.p_sheen * d;
   }
   const Vec3 h = normalize(wo + wi);
   if (l.p_coat > 0) {
@@ -274,6 +240,7 @@ bool pbr_sample(const PbrParams& p, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s
   float x = u_lobe;
   if (x < l.p_diffuse + l.p_sheen) {
     wi = sample_cosine_hemisphere(u);
+    if (x >= l.p_diffuse) wi = sheen::sample(l.sheen_ltc, wi);
     if (l.flip) wi = mirrored(wi);
   } else if ((x -= l.p_diffuse + l.p_sheen) < l.p_metal + l.p_spec + l.p_coat) {
     const float alpha = x < l.p_metal + l.p_spec ? l.alpha : l.coat_alpha;

@@ -5,8 +5,10 @@
 // (Walter et al. 2007). Single-scattering GGX loses energy on rough surfaces: the reflection lobes
 // are scaled back up as Turquin 2019 ("Practical multiple scattering compensation for microfacet
 // models") does, and the base under the specular layer is weighted by what that layer leaves
-// (1 - its directional albedo towards wo, as Cycles layers its closures). Lobes are sampled in
-// proportion to their expected weight; the pdf is the mixture's, so MIS sees one BSDF.
+// (1 - its directional albedo towards wo, as Cycles layers its closures). On top, in that order,
+// KHR_materials_clearcoat's GGX coat (ior 1.5) and KHR_materials_sheen's microfibre sheen
+// (sheen.h), each layered the same way. Lobes are sampled in proportion to their expected weight;
+// the pdf is the mixture's, so MIS sees one BSDF.
 // Frame conventions as materials.h: z > 0 is the outside for transmissive materials.
 #pragma once
 

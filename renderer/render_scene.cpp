@@ -110,7 +110,9 @@ SceneBase make_scene_base(const SceneDesc& desc) {
         l.direction = ld.direction;
         l.cos_cutoff = std::cos(std::min(ld.spot_angle_deg, 360.0f) * 0.5f * kPi / 180);
         l.exponent = ld.spot_exponent;
-        if (ld.spot_inner_deg >= 0) l.cos_inner = std::cos(std::min(ld.spot_inner_deg, 360.0f) * 0.5f * kPi / 180);
+        // Blender's importer: spot_blend = 1 - inner / outer, and Cycles' band (1 - cos outer) x blend.
+        if (ld.spot_inner_deg >= 0 && ld.spot_angle_deg > 0)
+          l.spot_smooth = (1 - l.cos_cutoff) * clampf(1 - ld.spot_inner_deg / ld.spot_angle_deg, 0, 1);
         break;
       case LightType::directional: l.kind = LightKind::directional; l.direction = ld.direction; break;
       case LightType::ambient: l.kind = LightKind::ambient; break;

@@ -120,8 +120,8 @@ struct LightDesc {
   Vec3 dim_x{1, 0, 0}, dim_y{0, 1, 0};  // area rectangle edges (full lengths)
   float spot_angle_deg = 45;    // full cone angle (COLLADA falloff_angle)
   float spot_exponent = 0;      // COLLADA falloff_exponent: cos^e fall-off inside the cone
-  // glTF: the full angle of the cone of full intensity; from it to spot_angle_deg the intensity
-  // falls as KHR_lights_punctual recommends (squared, linear in the cosine). < 0: no such cone.
+  // glTF: the full angle of the inner cone; the edge softens over a band that grows as it narrows
+  // (Blender's spot_blend = 1 - inner / outer, render_scene.cpp). < 0: no such cone.
   float spot_inner_deg = -1;
 };
 

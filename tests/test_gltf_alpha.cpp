@@ -164,3 +164,14 @@ TEST(GltfAlpha, BadValuesAreNamed) {
   }
   EXPECT_TRUE(test::fails_at(cutout_scene(json{{"alphaMode", "MASK"}, {"alphaCutoff", -0.5}}).text(), "/materials/0/alphaCutoff"));
 }
+
+// A texel's colour is the file's, not premultiplied by its alpha (glTF 2.0, 3.9.2): an unlit card
+// shows the texture's white where MASK keeps a texel of alpha 100/255, not 100/255 of it.
+TEST(GltfAlpha, TexelColoursAreNotPremultiplied) {
+  GltfDoc g = cutout_scene(json{{"alphaMode", "MASK"}, {"alphaCutoff", 0.3}});
+  g.doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 1};
+  g.doc["materials"][0]["extensions"] = {{"KHR_materials_unlit", json::object()}};
+  const ImageRGB img = render(g.text(), 4, 2);
+  for (int q = 1; q < 4; ++q)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(quarter(img, q, c).mean, 1.0, 1e-3) << "quarter " << q << " channel " << c;
+}

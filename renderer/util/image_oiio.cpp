@@ -210,7 +210,14 @@ std::vector<uint8_t> decode_rgb8(const uint8_t* data, size_t size, size_t max_pi
     }
   }
   OIIO::Filesystem::IOMemReader reader(data, size);
-  auto in = OIIO::ImageInput::open(name, nullptr, &reader);
+  // glTF's colours are not premultiplied by alpha (glTF 2.0, 3.9.2); OpenImageIO's PNG reader
+  // would premultiply them, darkening every texel that is not opaque.
+  // With a config, OpenImageIO 2.4 takes the proxy from it, not from the argument.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  OIIO::Filesystem::IOProxy* proxy = &reader;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto in = OIIO::ImageInput::open(name, &config, &reader);
   if (!in) throw std::runtime_error("cannot decode the image: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
