@@ -259,6 +259,15 @@ bool Camera::sensor_point(Vec3 p, Vec2 lens_u, float& sx, float& sy, Vec3& origi
   return std::isfinite(sx) && std::isfinite(sy);
 }
 
+Camera camera_looking(Camera c, Vec3 position, Vec3 target) {
+  const Vec3 back = position - target;
+  if (!(length(back) > 0) || !is_finite(back)) return c;
+  c.position = position;
+  c.target = target;
+  set_basis(c, back, Vec3(0, 1, 0));
+  return c;
+}
+
 void write_camera_settings(const Camera& c, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path + ": cannot write camera settings");

@@ -52,6 +52,10 @@ struct Camera {
   bool sensor_point(Vec3 p, Vec2 lens_u, float& sx, float& sy, Vec3& origin) const;
 };
 
+// `c` moved to look from `position` at `target` with world up +Y, its field of view, size and lens
+// kept: what the window's orbit, pan and dolly show. A pose with position == target keeps c.
+Camera camera_looking(Camera c, Vec3 position, Vec3 target);
+
 // Builds the camera; throws std::runtime_error naming the settings file on a bad -c file.
 Camera make_camera(const SceneDesc& scene, const CameraParams& params);
 // The same from what the camera reads of a scene: the file's camera and the geometry bounds (the

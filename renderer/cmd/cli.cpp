@@ -243,6 +243,7 @@ std::string usage_text(const std::string& program) {
 "  --output-dir <DIR>  window only: where S and D write (default: the current directory)\n"
 "  --script <FILE> window only: replay input from FILE, one command a line (for tests):\n"
 "                  wait_spp N | wait_ms N | key K | click X Y | resize W H | sync |\n"
+"                  drag left|right X0 Y0 X1 Y1 STEPS | wheel N |\n"
 "                  title | overlay | screenshot FILE.png | close | quit\n"
 "\n"
 "Window keys (without -f; the render restarts after each change):\n" + window_keys_text() +
@@ -262,6 +263,10 @@ std::string window_keys_text() {
 "                  in the current directory (or --output-dir)\n"
 "  D               write the camera settings to <scene>_cam_settings.txt (there too)\n"
 "  click           focus the thin lens on the surface under the cursor (autofocus)\n"
+"  left drag       orbit the camera around its target (a coarse preview while moving)\n"
+"  right drag      pan camera and target in the view plane\n"
+"  wheel           dolly towards / away from the target\n"
+"  Space           back to the initial camera\n"
 "  H (or `)        show / hide the status panel (samples, error, ETA, settings)\n"
 "  ? (/)           list these keys (in the panel and on stdout)\n"
 "  Esc / Q         quit\n";

@@ -25,6 +25,7 @@
 #include "overlay.h"
 #include "scene_file.h"
 #include "session.h"
+#include "viewer_keys.h"
 #include "viewer_loop.h"
 #include "viewer_script.h"
 
@@ -38,6 +39,10 @@ using namespace viewer;
 
 constexpr double kScriptTimeoutMs = 120000;
 constexpr double kResizeSettleMs = 150;
+// While the camera moves the render runs at 1/kPreviewScale of the window's size (a coarse preview,
+// the same renderer); kRestMs after the last wheel step, or when a drag ends, it renders in full.
+constexpr int kPreviewScale = 4;
+constexpr double kRestMs = 150;
 constexpr int kMinWindowW = 160, kMinWindowH = 120;
 
 class Viewer {
@@ -49,11 +54,13 @@ class Viewer {
       if (action != GLFW_RELEASE) self(w)->on_key(key, action == GLFW_REPEAT);
     });
     glfwSetMouseButtonCallback(win, [](GLFWwindow* w, int button, int action, int) {
-      if (action != GLFW_RELEASE || (button != GLFW_MOUSE_BUTTON_LEFT && button != GLFW_MOUSE_BUTTON_RIGHT)) return;
+      if (button != GLFW_MOUSE_BUTTON_LEFT && button != GLFW_MOUSE_BUTTON_RIGHT) return;
       double x, y;
       glfwGetCursorPos(w, &x, &y);
-      self(w)->on_click(x, y);
+      self(w)->on_button(button == GLFW_MOUSE_BUTTON_LEFT ? CameraNav::left : CameraNav::right, action == GLFW_PRESS, x, y);
     });
+    glfwSetCursorPosCallback(win, [](GLFWwindow* w, double x, double y) { self(w)->on_cursor(x, y); });
+    glfwSetScrollCallback(win, [](GLFWwindow* w, double, double dy) { self(w)->on_wheel(dy); });
     glfwSetFramebufferSizeCallback(win, [](GLFWwindow* w, int width, int height) {
       Viewer* v = self(w);
       v->m_resize_w = width;
@@ -71,6 +78,7 @@ class Viewer {
     m_sh.want.cell_x = m_sh.want.cell_y = m_sh.want.cell_w = m_sh.want.cell_h = 0;
     m_sh.want.width = std::min(std::max(1, fw), 16384);
     m_sh.want.height = std::min(std::max(1, fh), 16384);
+    m_nav.reset(make_camera(m_desc, camera_params(m_sh.want)));
     if (m_options.params.cell_w > 0) say("window: -p is ignored; the window renders the whole frame");
     say("window: %dx%d, %s", m_sh.want.width, m_sh.want.height, settings_text(m_sh.want).c_str());
 
@@ -92,6 +100,7 @@ class Viewer {
       }
       upload_tiles(st);  // after the status snapshot: a completed pass's tiles are all queued by then
       apply_resize();
+      settle_view(false);
       if (m_script_pos < m_script.size()) step_script(st);
       if (m_dirty || panel_changed()) {
         draw();
@@ -146,46 +155,9 @@ class Viewer {
 
   void on_key(int key, bool repeat) {
     if (key != GLFW_KEY_SLASH) set_show_keys(false);
-    switch (key) {
-      case GLFW_KEY_ESCAPE:
-      case GLFW_KEY_Q: glfwSetWindowShouldClose(m_win, GLFW_TRUE); break;
-      case GLFW_KEY_R: change([](RenderParams&) { return std::string("restart"); }); break;
-      case GLFW_KEY_PERIOD:
-        change([](RenderParams& p) {
-          p.max_depth = std::min(p.max_depth + 1, 1000000);
-          return "max depth " + std::to_string(p.max_depth);
-        });
-        break;
-      case GLFW_KEY_COMMA:
-        change([](RenderParams& p) {
-          p.max_depth = std::max(p.max_depth - 1, 0);
-          return "max depth " + std::to_string(p.max_depth);
-        });
-        break;
-      case GLFW_KEY_L: change([](RenderParams& p) { return step_lens(p, +0.05f); }); break;
-      case GLFW_KEY_K: change([](RenderParams& p) { return step_lens(p, -0.05f); }); break;
-      case GLFW_KEY_APOSTROPHE: change([](RenderParams& p) { return step_focus(p, +0.1f); }); break;
-      case GLFW_KEY_SEMICOLON: change([](RenderParams& p) { return step_focus(p, -0.1f); }); break;
-      case GLFW_KEY_RIGHT_BRACKET:
-        change([](RenderParams& p) { p.spp = std::min(p.spp * 2, 1 << 24); return "spp " + std::to_string(p.spp); });
-        break;
-      case GLFW_KEY_LEFT_BRACKET:
-        change([](RenderParams& p) { p.spp = std::max(p.spp / 2, 1); return "spp " + std::to_string(p.spp); });
-        break;
-      case GLFW_KEY_EQUAL:
-        change([](RenderParams& p) {
-          p.light_samples = std::min(p.light_samples * 2, 65536);
-          return "light samples " + std::to_string(p.light_samples);
-        });
-        break;
-      case GLFW_KEY_MINUS:
-        change([](RenderParams& p) {
-          p.light_samples = std::max(p.light_samples / 2, 1);
-          return "light samples " + std::to_string(p.light_samples);
-        });
-        break;
-      default: break;
-    }
+    if (is_setting_key(key)) change([key](RenderParams& p) { return apply_setting_key(key, p); });
+    if (key == GLFW_KEY_ESCAPE || key == GLFW_KEY_Q) glfwSetWindowShouldClose(m_win, GLFW_TRUE);
+    if (key == GLFW_KEY_R) change([](RenderParams&) { return std::string("restart"); });
     if (repeat) return;  // the keys below act once per press
     switch (key) {
       case GLFW_KEY_T:
@@ -195,6 +167,11 @@ class Viewer {
         break;
       case GLFW_KEY_S: push_command({CommandKind::save}); break;
       case GLFW_KEY_D: write_camera(); break;
+      case GLFW_KEY_SPACE:
+        m_nav.home();
+        moved_view();
+        settle_view(true);
+        break;
       case GLFW_KEY_SLASH:  // '?' on most layouts
         set_show_keys(!m_show_keys);
         if (m_show_keys) {
@@ -217,18 +194,6 @@ class Viewer {
     m_show_keys = on;
   }
 
-  static std::string step_lens(RenderParams& p, float step) {
-    p.lens_radius = std::max(0.0f, p.lens_radius + step);
-    if (p.lens_radius < 1e-6f) p.lens_radius = 0;
-    return "lens radius " + fmt_g(p.lens_radius);
-  }
-
-  static std::string step_focus(RenderParams& p, float step) {
-    p.focal_distance = std::min(std::max(0.0f, p.focal_distance + step), 1e12f);
-    if (p.focal_distance < 1e-6f) p.focal_distance = 0;
-    return "focal distance " + fmt_g(p.focal_distance);
-  }
-
   void on_click(double x, double y) {
     int ww, wh;
     glfwGetWindowSize(m_win, &ww, &wh);
@@ -237,15 +202,66 @@ class Viewer {
     push_command({CommandKind::focus, float(x / ww), float(1 - y / wh)});
   }
 
+  // ---- camera navigation (viewer_nav.h) ----
+
+  void on_button(CameraNav::Button b, bool down, double x, double y) {
+    if (down) return m_nav.press(b, x, y);
+    const bool dragged = m_nav.dragging();
+    if (m_nav.release(x, y)) on_click(x, y);  // a click focuses, as before
+    if (dragged) settle_view(true);
+  }
+
+  void on_cursor(double x, double y) {
+    int ww, wh;
+    glfwGetWindowSize(m_win, &ww, &wh);
+    if (m_nav.move(x, y, ww, wh, shown_camera())) moved_view();
+  }
+
+  void on_wheel(double steps) {
+    if (m_nav.scroll(steps)) moved_view();
+  }
+
+  // The camera the window shows now, at the full window size.
+  Camera shown_camera() {
+    std::lock_guard<std::mutex> lk(m_sh.mutex);
+    RenderParams p = m_sh.want;
+    if (m_previewing) p.width = m_full_w, p.height = m_full_h;
+    return view_camera(m_desc, p, m_sh.view);
+  }
+
+  // A new pose: a coarse preview renders at once (the previous one is cancelled).
+  void moved_view() {
+    m_moved_at = Clock::now();
+    change([this](RenderParams& p) {
+      m_sh.view = m_nav.pose();
+      if (!m_previewing) m_full_w = p.width, m_full_h = p.height;
+      m_previewing = true;
+      p.width = std::max(1, m_full_w / kPreviewScale);
+      p.height = std::max(1, m_full_h / kPreviewScale);
+      return std::string();
+    });
+  }
+
+  // Once the view rests (or at once with `now`), the full-size render of the new pose.
+  void settle_view(bool now) {
+    if (!m_previewing || (!now && (m_nav.dragging() || ms_since(m_moved_at) < kRestMs))) return;
+    m_previewing = false;
+    change([this](RenderParams& p) {
+      p.width = m_full_w, p.height = m_full_h;
+      const ViewPose v = m_sh.view;
+      if (!v.moved) return std::string("camera: initial");
+      char text[200];
+      std::snprintf(text, sizeof text, "camera: position %s %s %s, target %s %s %s", fmt_g(v.position.x).c_str(),
+                    fmt_g(v.position.y).c_str(), fmt_g(v.position.z).c_str(), fmt_g(v.target.x).c_str(),
+                    fmt_g(v.target.y).c_str(), fmt_g(v.target.z).c_str());
+      return std::string(text);
+    });
+  }
+
   void write_camera() {
-    RenderParams p;
-    {
-      std::lock_guard<std::mutex> lk(m_sh.mutex);
-      p = m_sh.want;
-    }
     std::string path = output_path(m_options, "_cam_settings.txt");
     try {
-      write_camera_settings(make_camera(m_desc, camera_params(p)), path);
+      write_camera_settings(shown_camera(), path);
       say("wrote %s", path.c_str());
     } catch (const std::exception& e) {
       say("camera settings: %s", e.what());
@@ -437,6 +453,15 @@ class Viewer {
         on_key(key_code(l.words[1]), false);
       } else if (c == "click") {
         on_click(arg(1), arg(2));
+      } else if (c == "drag") {  // press, STEPS moves along the line, release: as a hand would
+        const int steps = std::max(1, int(arg(6)));
+        on_button(l.words[1] == "left" ? CameraNav::left : CameraNav::right, true, arg(2), arg(3));
+        for (int k = 1; k <= steps; ++k)
+          on_cursor(arg(2) + (arg(4) - arg(2)) * k / steps, arg(3) + (arg(5) - arg(3)) * k / steps);
+        on_button(l.words[1] == "left" ? CameraNav::left : CameraNav::right, false, arg(4), arg(5));
+      } else if (c == "wheel") {
+        on_wheel(arg(1));
+        settle_view(true);
       } else if (c == "title") {
         update_title(st);
         say("title: %s", m_title.c_str());
@@ -496,6 +521,10 @@ class Viewer {
   std::vector<std::string> m_panel_lines;  // as last drawn: the ETA counts down between passes
   int m_resize_w = 0, m_resize_h = 0;
   Clock::time_point m_resize_at;
+  CameraNav m_nav;
+  bool m_previewing = false;  // rendering at 1/kPreviewScale while the camera moves
+  int m_full_w = 0, m_full_h = 0;
+  Clock::time_point m_moved_at;
   std::string m_title;
   std::vector<ScriptLine> m_script;
   size_t m_script_pos = 0;

@@ -60,8 +60,9 @@ void RenderLoop::loop() {
       Command c = m_sh.commands.front();
       m_sh.commands.pop_front();
       RenderParams want = m_sh.want;
+      ViewPose view = m_sh.view;
       lk.unlock();
-      float focus = handle(c, want);
+      float focus = handle(c, want, view);
       lk.lock();
       if (c.kind == CommandKind::focus && std::isfinite(focus)) {
         m_sh.want.focal_distance = focus;
@@ -73,9 +74,10 @@ void RenderLoop::loop() {
     }
     if (!m_session || m_gen != m_sh.want_gen) {
       RenderParams p = m_sh.want;
+      ViewPose view = m_sh.view;
       uint64_t gen = m_sh.want_gen;
       lk.unlock();
-      start_session(p, gen);
+      start_session(p, view, gen);
       lk.lock();
       continue;
     }
@@ -116,10 +118,15 @@ void RenderLoop::loop() {
   }
 }
 
-void RenderLoop::start_session(const RenderParams& p, uint64_t gen) {
+Camera view_camera(const SceneDesc& desc, const RenderParams& p, const ViewPose& view) {
+  Camera c = make_camera(desc, camera_params(p));
+  return view.moved ? camera_looking(c, view.position, view.target) : c;
+}
+
+void RenderLoop::start_session(const RenderParams& p, const ViewPose& view, uint64_t gen) {
   m_driver.reset();
   m_session.reset();
-  m_scene.camera = make_camera(m_desc, camera_params(p));
+  m_scene.camera = view_camera(m_desc, p, view);
   m_driver.reset();
   m_session = std::make_unique<RenderSession>(m_scene, p);
   m_driver = std::make_unique<ProgressiveDriver>(*m_session, m_options.limits);
@@ -157,11 +164,11 @@ void RenderLoop::send_tile(uint64_t gen, const RenderSession& s, const Tile& t) 
   if (was_empty) m_sh.wake_window();
 }
 
-float RenderLoop::handle(const Command& c, const RenderParams& want) {
+float RenderLoop::handle(const Command& c, const RenderParams& want, const ViewPose& view) {
   if (c.kind == CommandKind::focus) {
     // The pinhole ray of the camera the window shows now (pose and size; lens settings do not matter).
     Camera current = m_scene.camera;
-    m_scene.camera = make_camera(m_desc, camera_params(want));
+    m_scene.camera = view_camera(m_desc, want, view);
     float d = autofocus_distance(m_scene, c.sx, c.sy);
     m_scene.camera = current;
     if (std::isfinite(d))

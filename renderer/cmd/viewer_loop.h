@@ -18,6 +18,7 @@
 
 #include "cli.h"
 #include "session.h"
+#include "viewer_nav.h"
 
 namespace pt {
 namespace viewer {
@@ -66,10 +67,14 @@ struct Command {
   float sx = 0, sy = 0;  // focus: sensor point, y up
 };
 
+// The camera the window shows for settings p and the navigation's pose.
+Camera view_camera(const SceneDesc& desc, const RenderParams& p, const ViewPose& view);
+
 struct Shared {
   std::mutex mutex;
   std::condition_variable wake;
   RenderParams want;       // what the window asks for; a change bumps want_gen
+  ViewPose view;           // where the navigation put the camera (changes with want_gen too)
   uint64_t want_gen = 1;
   std::deque<Command> commands;
   uint64_t issued = 0, handled = 0;  // commands
@@ -95,12 +100,12 @@ class RenderLoop {
 
  private:
   void loop();
-  void start_session(const RenderParams& p, uint64_t gen);
+  void start_session(const RenderParams& p, const ViewPose& view, uint64_t gen);
   // Runs on a worker thread right after the tile is finished for this pass.
   void send_tile(uint64_t gen, const RenderSession& s, const Tile& t);
   // Runs between passes (the pass was cancelled to get here; it resumes where it stopped).
   // Returns the autofocus distance for a focus command.
-  float handle(const Command& c, const RenderParams& want);
+  float handle(const Command& c, const RenderParams& want, const ViewPose& view);
 
   const CliOptions& m_options;
   const SceneDesc& m_desc;

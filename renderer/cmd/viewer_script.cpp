@@ -3,6 +3,7 @@
 
 #include <GLFW/glfw3.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -13,6 +14,7 @@ namespace viewer {
 
 int key_code(const std::string& name) {
   if (name == "Esc" || name == "Escape" || name == "esc") return GLFW_KEY_ESCAPE;
+  if (name == "Space" || name == "space") return GLFW_KEY_SPACE;
   if (name.size() != 1) return -1;
   char c = name[0];
   if (c >= 'a' && c <= 'z') return GLFW_KEY_A + (c - 'a');
@@ -44,8 +46,9 @@ std::vector<ScriptLine> load_script(const std::string& path) {
     for (std::string w; ws >> w;) l.words.push_back(w);
     if (l.words.empty() || l.words[0][0] == '#') continue;
     const std::string& c = l.words[0];
-    size_t want_args = c == "wait_spp" || c == "wait_ms" || c == "key" || c == "screenshot"             ? 1
+    size_t want_args = c == "wait_spp" || c == "wait_ms" || c == "key" || c == "screenshot" || c == "wheel" ? 1
                        : c == "click" || c == "resize"                                                      ? 2
+                       : c == "drag"                                                                        ? 6
                        : c == "sync" || c == "title" || c == "overlay" || c == "close" || c == "quit" ? 0
                                                                                                             : size_t(-1);
     std::string where = path + ":" + std::to_string(n) + ": ";
@@ -53,9 +56,12 @@ std::vector<ScriptLine> load_script(const std::string& path) {
     if (l.words.size() != want_args + 1)
       throw std::runtime_error(where + c + " takes " + std::to_string(want_args) + " argument(s)");
     if (c == "key" && key_code(l.words[1]) < 0) throw std::runtime_error(where + "unknown key '" + l.words[1] + "'");
-    for (size_t i = 1; i < l.words.size() && c != "key" && c != "screenshot"; ++i) {
+    if (c == "drag" && l.words[1] != "left" && l.words[1] != "right")
+      throw std::runtime_error(where + "drag takes left or right, then X0 Y0 X1 Y1 STEPS");
+    for (size_t i = c == "drag" ? 2 : 1; i < l.words.size() && c != "key" && c != "screenshot"; ++i) {
       char* end = nullptr;
       double v = std::strtod(l.words[i].c_str(), &end);
+      if (c == "wheel" && *end == '\0' && std::isfinite(v)) continue;  // either way
       if (*end != '\0' || !(v >= 0)) throw std::runtime_error(where + "'" + l.words[i] + "' is not a number >= 0");
     }
     out.push_back(std::move(l));
