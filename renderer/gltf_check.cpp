@@ -45,7 +45,7 @@ void Checker::materials() {
         number(*e, "clearcoatRoughnessFactor", c, false, 0, 1);
         texture_info(*e, "clearcoatTexture", c, true);
         texture_info(*e, "clearcoatRoughnessTexture", c, true);
-        texture_info(*e, "clearcoatNormalTexture", c);
+        texture_info(*e, "clearcoatNormalTexture", c, true);
       }
       if (const json* e = object(*ext, "KHR_materials_sheen", at)) {
         const std::string s = at + "/KHR_materials_sheen";

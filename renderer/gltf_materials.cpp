@@ -206,9 +206,13 @@ Material MaterialMaker::make(int index, bool vertex_color, const std::string& pa
     if (p.clearcoat > 0) {
       p.clearcoat_tex = extension_texture(*c, "clearcoatTexture", false, c_at);  // red
       p.clearcoat_roughness_tex = extension_texture(*c, "clearcoatRoughnessTexture", false, c_at);  // green
-      if (c->Has("clearcoatNormalTexture"))
-        m_ctx.warn("clearcoat normal map", c_at + "/clearcoatNormalTexture",
-                   "the coat's own normal map is not read: the coat follows the base's shading normal");
+      p.clearcoat_normal_tex = extension_texture(*c, "clearcoatNormalTexture", false, c_at);
+      if (p.clearcoat_normal_tex.used()) {
+        p.clearcoat_normal_scale = float(number(&c->Get("clearcoatNormalTexture"), "scale", 1));
+        if (p.normal_tex.used() && p.clearcoat_normal_tex.set != p.normal_tex.set)
+          m_ctx.warn("clearcoat normal map", c_at + "/clearcoatNormalTexture",
+                     "reads another uv set than normalTexture: the tangents of normalTexture's set are used");
+      }
     }
   }
   if (const tinygltf::Value* s = extension(g.extensions, "KHR_materials_sheen")) {

@@ -306,8 +306,8 @@ void Builder::add_primitive(const tinygltf::Primitive& prim, const Mat4& world, 
       for (size_t v = 0; v < nv; ++v) mesh.color_alpha[v] = c[4 * v + 3];
     }
   }
-  if (pm.normal_tex.used()) add_tangents(mesh, attr("TANGENT"), attr(("TEXCOORD_" + std::to_string(pm.normal_tex.set)).c_str()) >= 0,
-                                         pm.normal_tex.set, world, apath);
+  if (const TextureRef* t = pm.tangent_space_tex())
+    add_tangents(mesh, attr("TANGENT"), attr(("TEXCOORD_" + std::to_string(t->set)).c_str()) >= 0, t->set, world, apath);
   mesh.tri_material.assign(tris, mat);
   if (tris) m_desc.meshes.push_back(std::move(mesh));
 }
@@ -315,7 +315,10 @@ void Builder::add_primitive(const tinygltf::Primitive& prim, const Mat4& world, 
 void Builder::add_tangents(MeshDesc& mesh, int tangent_accessor, bool has_uvs, int set, const Mat4& world,
                            const std::string& apath) {
   const size_t nv = mesh.positions.size();
-  if (!has_uvs) return;  // warned: the normal map is ignored
+  if (!has_uvs) {  // warned: the normal map is ignored (zero tangents bend nothing)
+    mesh.tangents.assign(nv, {0, 0, 0, 1});
+    return;
+  }
   if (tangent_accessor >= 0) {
     int n = 0;
     std::vector<float> t = read_floats(tangent_accessor, apath + "TANGENT", {4}, n);

@@ -306,8 +306,11 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
   // Shading frame. Opaque surfaces are two-sided: turn the normals towards the viewer.
   Vec3 ng = hit.ng;
   bool transmissive = has_transmission<F>(material);
+  const Vec3 ns_hit = ns;
   face_viewer(wo_world, transmissive, ng, ns);
   Vertex v{hit, material, Frame(ns), ng, Vec3(), transmissive};
+  if constexpr ((F & kFeatTexture) != 0)
+    if (material.pbr.clearcoat > 0) localize_coat(material, v.frame, dot(ns_hit, ns) < 0);
   v.wo = v.frame.to_local(wo_world);
 
   if (!has_delta<F>(material)) {

@@ -58,6 +58,8 @@ struct Lobes {
   Vec3 metal_comp;      // the same for the metal
   Vec3 metal_w, spec_w, diffuse_w, trans_w;  // each lobe's share of the material
   float coat = 0, coat_alpha = 1, coat_comp = 1;  // KHR_materials_clearcoat
+  bool coat_tilted = false;                       // the coat has its own normal: its lobe in coat_frame
+  Frame coat_frame;
   Vec3 sheen_w;                                   // KHR_materials_sheen: colour x albedo x what the coat leaves
   sheen::Ltc sheen_ltc;
   float p_metal = 0, p_spec = 0, p_diffuse = 0, p_trans = 0, p_coat = 0, p_sheen = 0;
@@ -100,8 +102,14 @@ Lobes prepare(const PbrParams& p, Vec3 wo) {
   if (l.coat > 0) {
     const float rc = clampf(p.clearcoat_roughness, 0, 1);
     l.coat_alpha = ggx::alpha_of(rc);
-    l.coat_comp = 1 + ggx::fresnel(1, kCoatEta) * (1 / std::max(1e-4f, ggx::albedo_one(mu, rc)) - 1);
-    const float ec = std::min(1.0f, ggx::albedo_dielectric(mu, rc, kCoatEta) * l.coat_comp);
+    float mu_c = mu;
+    if (p.coat_normal.z < 1 && !is_black(p.coat_normal)) {  // its own normal (a normal map's)
+      l.coat_tilted = true;
+      l.coat_frame = Frame(p.coat_normal);
+      mu_c = std::min(1.0f, std::max(0.0f, l.coat_frame.to_local(l.flip ? mirrored(wo) : wo).z));
+    }
+    l.coat_comp = 1 + ggx::fresnel(1, kCoatEta) * (1 / std::max(1e-4f, ggx::albedo_one(mu_c, rc)) - 1);
+    const float ec = mu_c > 0 ? std::min(1.0f, ggx::albedo_dielectric(mu_c, rc, kCoatEta) * l.coat_comp) : 0.0f;
     l.p_coat = l.coat * ec;
     under = 1 - l.coat * ec;
   }
@@ -150,11 +158,17 @@ void opaque(const Lobes& l, Vec3 wo, Vec3 wi, Vec3& f, float& pdf) {
   }
   const Vec3 h = normalize(wo + wi);
   if (l.p_coat > 0) {
-    const float dc = ggx::d(h, l.coat_alpha);
+    // In the coat's own frame where it has a normal map (both directions above the base too).
+    const Vec3 wo_c = l.coat_tilted ? l.coat_frame.to_local(wo) : wo, wi_c = l.coat_tilted ? l.coat_frame.to_local(wi) : wi;
+    const Vec3 h_c = l.coat_tilted ? l.coat_frame.to_local(h) : h;
+    const float dc = wo_c.z > 0 && wi_c.z > 0 ? ggx::d(h_c, l.coat_alpha) : 0.0f;
     if (dc > 0) {
-      f += Vec3(l.coat * l.coat_comp * ggx::fresnel(dot(wo, h), kCoatEta) * dc * ggx::g2(wo, wi, l.coat_alpha) /
-                (4 * wo.z * wi.z));
-      pdf += l.p_coat * ggx::g1(wo, l.coat_alpha) * dc / (4 * wo.z);
+      // The integrator weighs f by the cosine to the shading normal; the coat's own cosine is to
+      // its normal (as Cycles' closures each carry theirs): wi_c.z / wi.z turns one into the other.
+      const float cosines = l.coat_tilted ? wi_c.z / wi.z : 1.0f;
+      f += Vec3(l.coat * l.coat_comp * ggx::fresnel(dot(wo_c, h_c), kCoatEta) * dc * ggx::g2(wo_c, wi_c, l.coat_alpha) /
+                (4 * wo_c.z * wi_c.z) * cosines);
+      pdf += l.p_coat * ggx::g1(wo_c, l.coat_alpha) * dc / (4 * wo_c.z);
     }
   }
   if (l.p_metal <= 0 && l.p_spec <= 0) return;
@@ -243,8 +257,15 @@ bool pbr_sample(const PbrParams& p, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s
     if (x >= l.p_diffuse) wi = sheen::sample(l.sheen_ltc, wi);
     if (l.flip) wi = mirrored(wi);
   } else if ((x -= l.p_diffuse + l.p_sheen) < l.p_metal + l.p_spec + l.p_coat) {
-    const float alpha = x < l.p_metal + l.p_spec ? l.alpha : l.coat_alpha;
-    wi = reflect(wo_up, ggx::sample_visible(wo_up, alpha, u));
+    if (x < l.p_metal + l.p_spec || !l.coat_tilted) {
+      wi = reflect(wo_up, ggx::sample_visible(wo_up, x < l.p_metal + l.p_spec ? l.alpha : l.coat_alpha, u));
+    } else {  // the coat's visible normals, in its frame
+      const Vec3 wo_c = l.coat_frame.to_local(wo_up);
+      if (wo_c.z <= 0) return false;
+      const Vec3 wi_c = reflect(wo_c, ggx::sample_visible(wo_c, l.coat_alpha, u));
+      if (wi_c.z <= 0) return false;  // below the coat: not in its lobe
+      wi = l.coat_frame.to_world(wi_c);
+    }
     if (wi.z <= 0) return false;
     if (l.flip) wi = mirrored(wi);
   } else {

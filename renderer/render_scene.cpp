@@ -24,7 +24,7 @@ const char* unreadable_textures(const PbrParams& p, const MeshDesc& mesh, size_t
     if (size_t(r->texture) >= textures) return "its texture";
     if ((r->set == 0 ? mesh.uvs : mesh.uvs1).size() != nv) return "texture coordinates";
   }
-  if (p.normal_tex.used() && mesh.tangents.size() != nv) return "tangents";
+  if (p.tangent_space_tex() && mesh.tangents.size() != nv) return "tangents";
   if (p.vertex_color && mesh.colors.size() != nv) return "vertex colours";
   return nullptr;
 }

@@ -107,6 +107,11 @@ const Material& textured_material(const RenderScene& scene, const Material& m, c
 // Alpha is baseColorFactor's x the base colour texture's x COLOR_0's (glTF 2.0, 3.9.4).
 bool alpha_covers(const std::vector<TextureDesc>& textures, const PbrParams& p, const HitAttributes& at, float u);
 
+// After the path vertex has built its shading frame (and turned it to the viewer: `flipped`), puts
+// the coat normal that textured_material found for `m` into that frame (PbrParams::coat_normal).
+// Nothing for other materials.
+void localize_coat(const Material& m, const Frame& frame, bool flipped);
+
 // The material a path sees at a hit: `m`, or textured_material for a textured one.
 inline const Material& material_at(const RenderScene& scene, const Material& m, const SurfaceHit& hit, Vec3& ns) {
   return __builtin_expect(m.textured(), 0) ? textured_material(scene, m, hit, ns) : m;

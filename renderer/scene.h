@@ -41,6 +41,10 @@ struct PbrParams {
   Vec3 emissive{0, 0, 0};                  // emissiveFactor x KHR_materials_emissive_strength
   float normal_scale = 1;
   float clearcoat = 0, clearcoat_roughness = 0;  // KHR_materials_clearcoat
+  float clearcoat_normal_scale = 1;
+  // The coat's normal in the shading frame of the hit (path_vertex.h sets it from the coat's normal
+  // map, or from the unbent normal under a base normal map); zero: the shading normal.
+  Vec3 coat_normal{0, 0, 0};
   Vec3 sheen_color{0, 0, 0};                     // KHR_materials_sheen
   float sheen_roughness = 0;
   Vec3 attenuation{0, 0, 0};  // KHR_materials_volume: absorption per unit length inside the mesh
@@ -51,23 +55,27 @@ struct PbrParams {
   float alpha = 1;                         // baseColorFactor's alpha (x the texture's x COLOR_0's)
   float alpha_cutoff = 0.5f;               // MASK: alpha below it is cut out
   TextureRef base_tex, metal_rough_tex, emissive_tex, normal_tex, transmission_tex;
-  TextureRef specular_tex, specular_color_tex, clearcoat_tex, clearcoat_roughness_tex, sheen_color_tex,
-      sheen_roughness_tex;
+  TextureRef specular_tex, specular_color_tex, clearcoat_tex, clearcoat_roughness_tex, clearcoat_normal_tex,
+      sheen_color_tex, sheen_roughness_tex;
   // Every texture slot, for what looks at them all (the loader's uv sets, the mesh checks).
-  std::array<const TextureRef*, 11> texture_refs() const {
+  std::array<const TextureRef*, 12> texture_refs() const {
     return {&base_tex,     &metal_rough_tex,    &emissive_tex,  &normal_tex,
             &transmission_tex, &specular_tex,   &specular_color_tex, &clearcoat_tex,
-            &clearcoat_roughness_tex, &sheen_color_tex, &sheen_roughness_tex};
+            &clearcoat_roughness_tex, &clearcoat_normal_tex, &sheen_color_tex, &sheen_roughness_tex};
   }
-  std::array<TextureRef*, 11> texture_refs() {
+  std::array<TextureRef*, 12> texture_refs() {
     const auto c = const_cast<const PbrParams*>(this)->texture_refs();
-    std::array<TextureRef*, 11> out;
+    std::array<TextureRef*, 12> out;
     for (size_t i = 0; i < c.size(); ++i) out[i] = const_cast<TextureRef*>(c[i]);
     return out;
   }
   // Emission that light sampling cannot know: textured, cut out by alpha, or seen by camera rays
   // only (unlit). Such emitters are found by the rays that hit them, never registered as lights.
   bool emission_found_by_hits() const { return emissive_tex.used() || alpha_tested() || unlit; }
+  // The texture whose tangent frame the mesh must carry (a normal map's), or nullptr.
+  const TextureRef* tangent_space_tex() const {
+    return normal_tex.used() ? &normal_tex : clearcoat_normal_tex.used() ? &clearcoat_normal_tex : nullptr;
+  }
   bool alpha_tested() const { return alpha_mode != AlphaMode::opaque; }
   bool textured() const {
     bool any = vertex_color || alpha_tested();

@@ -21,9 +21,24 @@ Vec3 lookup(const RenderScene& scene, const TextureRef& ref, const HitAttributes
   return eval_texture((*scene.textures)[size_t(ref.texture)], texture_uv(ref, at));
 }
 
+// The material textured_material returns, per thread, and the coat normal it found (world space;
+// zero: the coat follows the shading normal).
+Material& scratch_material() {
+  thread_local Material scratch;
+  return scratch;
+}
+thread_local Vec3 t_coat_world;
+
 // The alpha channel, which specularTexture and sheenRoughnessTexture read.
 float alpha_lookup(const RenderScene& scene, const TextureRef& ref, const HitAttributes& at) {
   return eval_texture_alpha((*scene.textures)[size_t(ref.texture)], texture_uv(ref, at));
+}
+
+// A tangent-space normal map's normal at the hit: components in [-1, 1], x and y scaled.
+Vec3 tangent_normal(const RenderScene& scene, const TextureRef& ref, float scale, const HitAttributes& at) {
+  Vec3 n_t = lookup(scene, ref, at) * 2.0f - Vec3(1.0f);
+  n_t.x *= scale, n_t.y *= scale;
+  return n_t;
 }
 
 // The shading normal bent by a tangent-space normal n_t (components in [-1, 1], x and y scaled):
@@ -50,9 +65,15 @@ bool alpha_covers(const std::vector<TextureDesc>& textures, const PbrParams& p, 
   return true;
 }
 
+void localize_coat(const Material& m, const Frame& frame, bool flipped) {
+  if (&m != &scratch_material() || is_black(t_coat_world)) return;
+  const Vec3 n = normalize(frame.to_local(flipped ? -t_coat_world : t_coat_world));
+  scratch_material().pbr.coat_normal = is_finite(n) ? n : Vec3(0.0f);
+}
+
 [[gnu::noinline]] const Material& textured_material(const RenderScene& scene, const Material& m, const SurfaceHit& hit,
                                                     Vec3& ns) {
-  thread_local Material scratch;
+  Material& scratch = scratch_material();
   const PbrParams& in = m.pbr;
   PbrParams& p = scratch.pbr;
   scratch.type = MaterialType::pbr;
@@ -76,12 +97,15 @@ bool alpha_covers(const std::vector<TextureDesc>& textures, const PbrParams& p, 
   if (in.clearcoat_roughness_tex.used()) p.clearcoat_roughness *= lookup(scene, in.clearcoat_roughness_tex, at).y;
   if (in.sheen_color_tex.used()) p.sheen_color = p.sheen_color * lookup(scene, in.sheen_color_tex, at);
   if (in.sheen_roughness_tex.used()) p.sheen_roughness *= alpha_lookup(scene, in.sheen_roughness_tex, at);
-  if (in.normal_tex.used()) {
-    const Vec3 c = lookup(scene, in.normal_tex, at);
-    Vec3 n_t = c * 2.0f - Vec3(1.0f);
-    n_t.x *= in.normal_scale, n_t.y *= in.normal_scale;
-    ns = bend(ns, at, n_t);
-  }
+  const Vec3 unbent = ns;
+  if (in.normal_tex.used()) ns = bend(ns, at, tangent_normal(scene, in.normal_tex, in.normal_scale, at));
+  // The coat has its own normal: its map's, else the unbent one (KHR_materials_clearcoat). It is
+  // put into the shading frame once the path vertex has built it (localize_coat).
+  t_coat_world = Vec3(0.0f);
+  if (p.clearcoat > 0 && (in.normal_tex.used() || in.clearcoat_normal_tex.used()))
+    t_coat_world = in.clearcoat_normal_tex.used()
+                       ? bend(unbent, at, tangent_normal(scene, in.clearcoat_normal_tex, in.clearcoat_normal_scale, at))
+                       : unbent;
   return scratch;
 }
 

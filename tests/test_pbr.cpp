@@ -44,6 +44,11 @@ PbrParams sheened(PbrParams p, Vec3 colour, float roughness) {
   return p;
 }
 
+PbrParams tilted(PbrParams p, Vec3 coat_normal) {  // the coat's own normal, in the shading frame
+  p.coat_normal = coat_normal;
+  return p;
+}
+
 struct Case {
   std::string name;
   PbrParams p;
@@ -67,6 +72,7 @@ std::vector<Case> cases() {
       {"CoatedMetal", coated(params({0.9f, 0.6f, 0.3f}, 1, 0.6f), 0.7f, 0.3f)},
       {"Sheen", sheened(params({0.3f, 0.1f, 0.1f}, 0, 0.8f), {0.8f, 0.6f, 0.4f}, 0.5f)},
       {"CoatSheenGlass", coated(sheened(params({0.7f, 0.5f, 0.3f}, 0.3f, 0.6f, 0.5f), Vec3(0.5f), 0.3f), 0.5f, 0.2f)},
+      {"TiltedCoat", tilted(coated(params({0.2f, 0.4f, 0.8f}, 0, 0.5f), 1, 0.35f), normalize(Vec3(0.3f, 0.1f, 0.95f)))},
   };
 }
 

@@ -111,6 +111,7 @@ TEST(PbrLayers, NoEnergyGainAtAnyLimit) {
           p.clearcoat_roughness = r;
           p.sheen_color = sheen;
           p.sheen_roughness = r;
+          p.coat_normal = coat > 1 ? normalize(Vec3(0.6f, 0.2f, 0.5f)) : Vec3(0.0f);  // a coat normal map's tilt
           for (double theta : {0.0, 60.0, 89.9}) {
             const Vec3 a = albedo(p, dir_deg(theta), 20000, 13);
             ASSERT_TRUE(is_finite(a));
