@@ -247,3 +247,16 @@ TEST_F(Viewer, RestartAndCloseDoNotWaitForTheRunningPass) {
   EXPECT_EQ(r.output.find("pass: "), std::string::npos) << "a pass ended instead of being cancelled: " << r.output;
   std::printf("restart took %.0f ms; whole run %.2f s\n", value_after(r.output, "sync: "), r.seconds);
 }
+
+// Lowering the depth until the scene's mirror and glass go dark, then black, says why once each,
+// as the CLI's hints do; going back and forth does not repeat it.
+TEST_F(Viewer, ADepthThatBlacksOutMirrorsSaysWhyOnce) {
+  RunResult r = run_window("-t 2 -s 1 -m 3 -r 64 48", "wait_spp 1\nkey ,\nkey ,\nkey .\nkey ,\nsync\nquit\n");
+  auto count = [&](const std::string& s) {
+    size_t n = 0;
+    for (size_t at = 0; (at = r.output.find(s, at)) != std::string::npos; ++at) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("hint: -m 2 leaves mirror and glass dark"), 1u) << r.output;
+  EXPECT_EQ(count("hint: -m 1 leaves mirror and glass black"), 1u) << r.output;
+}

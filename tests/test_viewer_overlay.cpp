@@ -8,6 +8,7 @@
 #include <regex>
 
 #include "bitmap_font.h"
+#include "cli.h"
 #include "viewer_harness.h"
 
 using namespace pt;
@@ -206,4 +207,18 @@ TEST_F(Viewer, TheRateViewDrawsALegend) {
       if (!o.legend_rect.contains(x, y) && !o.rect.contains(x, y))
         changed_outside += !std::equal(img.at(x, y), img.at(x, y) + 3, clean.at(x, y));
   EXPECT_EQ(changed_outside, 0);
+}
+
+// ? lists every window key in a 320x240 window, each line whole (the panel's brief form), and the
+// font's lower case sits below the capital line ("spp", not "sPP").
+TEST_F(Viewer, TheKeyListFitsASmallWindowInLowerCase) {
+  RunResult r = run_window("-t 2 -s 1 -r 320 240", "wait_spp 1\nkey ?\noverlay\nquit\n");
+  const OverlayReport o = parse_overlay(last_line_with(r.output, "overlay: "));
+  ASSERT_TRUE(o.panel) << r.output;
+  EXPECT_EQ(o.lines.size(), window_keys().size()) << r.output;
+  EXPECT_TRUE(o.rect.inside(320, 240)) << r.output;
+  EXPECT_LE(o.rect.x + o.rect.w, 320 - o.rect.x) << "a line is clipped: " << r.output;
+  for (char c : std::string("acegmnopqrsuvwxyz"))
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < kGlyphW; ++x) EXPECT_FALSE(glyph_lit(c, x, y)) << "'" << c << "' reaches row " << y;
 }

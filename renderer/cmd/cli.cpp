@@ -250,26 +250,40 @@ std::string usage_text(const std::string& program) {
 "  The render follows the window's size: -r gives the initial window size.\n";
 }
 
+const std::vector<WindowKey>& window_keys() {
+  static const std::vector<WindowKey> keys = {
+      {"R", "restart", "restart the render"},
+      {". / ,", "depth +1 / -1", "max ray depth +1 / -1 (min 0)"},
+      {"L / K", "lens +/- 0.05", "lens radius +0.05 / -0.05 (min 0)"},
+      {"' / ;", "focus +/- 0.1", "focal distance +0.1 / -0.1 (min 0): focal plane farther / nearer"},
+      {"] / [", "spp x2 / /2", "samples per pixel x2 / /2"},
+      {"= / -", "light samples x2 / /2", "light samples x2 / /2"},
+      {"T", "sample-rate view", "toggle the sample-rate view (with its colour legend)"},
+      {"S", "save the image", "save <scene>_screenshot_<M>-<D>_<h>-<m>-<s>.png, .exr and _rate.png\n"
+                              "in the current directory (or --output-dir)"},
+      {"D", "write the camera", "write the camera settings to <scene>_cam_settings.txt (there too)"},
+      {"click", "focus there", "focus the thin lens on the surface under the cursor (autofocus)"},
+      {"left drag", "orbit", "orbit the camera around its target (a coarse preview while moving)"},
+      {"right drag", "pan", "pan camera and target in the view plane"},
+      {"wheel", "dolly", "dolly towards / away from the target"},
+      {"Space", "initial camera", "back to the initial camera"},
+      {"H (or `)", "panel on / off", "show / hide the status panel (samples, error, ETA, settings)"},
+      {"? (/)", "these keys", "list these keys (in the panel and on stdout)"},
+      {"Esc / Q", "quit", "quit"},
+  };
+  return keys;
+}
+
 std::string window_keys_text() {
-  return
-"  R               restart the render\n"
-"  . / ,           max ray depth +1 / -1 (min 0)\n"
-"  L / K           lens radius +0.05 / -0.05 (min 0)\n"
-"  ' / ;           focal distance +0.1 / -0.1 (min 0): focal plane farther / nearer\n"
-"  ] / [           samples per pixel x2 / /2\n"
-"  = / -           light samples x2 / /2\n"
-"  T               toggle the sample-rate view (with its colour legend)\n"
-"  S               save <scene>_screenshot_<M>-<D>_<h>-<m>-<s>.png, .exr and _rate.png\n"
-"                  in the current directory (or --output-dir)\n"
-"  D               write the camera settings to <scene>_cam_settings.txt (there too)\n"
-"  click           focus the thin lens on the surface under the cursor (autofocus)\n"
-"  left drag       orbit the camera around its target (a coarse preview while moving)\n"
-"  right drag      pan camera and target in the view plane\n"
-"  wheel           dolly towards / away from the target\n"
-"  Space           back to the initial camera\n"
-"  H (or `)        show / hide the status panel (samples, error, ETA, settings)\n"
-"  ? (/)           list these keys (in the panel and on stdout)\n"
-"  Esc / Q         quit\n";
+  std::string out;
+  for (const WindowKey& k : window_keys()) {
+    std::string key = std::string("  ") + k.keys;
+    key.resize(std::max<size_t>(key.size() + 1, 18), ' ');
+    std::string text = k.text;
+    for (size_t at = 0; (at = text.find('\n', at)) != std::string::npos; at += 19) text.insert(at + 1, std::string(18, ' '));
+    out += key + text + "\n";
+  }
+  return out;
 }
 
 Metadata render_metadata(const CliOptions& o, const RenderSession& session) {

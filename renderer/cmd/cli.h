@@ -39,7 +39,15 @@ std::string usage_text(const std::string& program);
 // The options --help lists ("-s", "--keep-fov", ...), and the one nearest a mistyped one ("" if none is near).
 std::vector<std::string> cli_option_names();
 std::string nearest_option(const std::string& given);
-// The debug window's keys, one a line (part of usage_text; the window's H key shows it).
+// The debug window's keys: what to press, a brief phrase for the window's panel (which must fit a
+// 320x240 window), the whole description for --help and the terminal.
+struct WindowKey {
+  const char* keys;
+  const char* brief;
+  const char* text;  // lines after the first indented by two spaces
+};
+const std::vector<WindowKey>& window_keys();
+// The keys as --help lists them, one a line (part of usage_text; the window's ? prints it).
 std::string window_keys_text();
 // The EXR header of a render: its parameters, achieved samples, wall time and error estimate.
 Metadata render_metadata(const CliOptions& options, const RenderSession& session);

@@ -9,17 +9,20 @@
 
 namespace pt {
 
+std::string depth_hint(int max_depth, const SceneFeatures& f) {
+  auto has = [&](const char* m) { return std::find(f.materials.begin(), f.materials.end(), m) != f.materials.end(); };
+  // Depth 1 is direct light only and depth 2 one bounce: a mirror shows the lit room from 2, glass
+  // (in, out, then the room) from 3 (cs184-spec: each specular event takes one level).
+  if (max_depth >= 3 || !(has("mirror") || has("glass") || has("refraction"))) return "";
+  return "-m " + std::to_string(max_depth) + " leaves mirror and glass " + (max_depth < 2 ? "black" : "dark") +
+         ": what they reflect and refract needs -m 3 or more (-m 5 for glass seen through glass)";
+}
+
 std::vector<std::string> render_hints(const CliOptions& o, const SceneFeatures& f, const Camera& camera,
                                       const Bounds3& bounds, bool course_framing) {
   std::vector<std::string> hints;
   const RenderParams& p = o.params;
-  auto has = [&](const char* m) { return std::find(f.materials.begin(), f.materials.end(), m) != f.materials.end(); };
-  // Depth 1 is direct light only and depth 2 one bounce: a mirror shows the lit room from 2, glass
-  // (in, out, then the room) from 3 (cs184-spec: each specular event takes one level).
-  if (p.max_depth < 3 && (has("mirror") || has("glass") || has("refraction")))
-    hints.push_back("-m " + std::to_string(p.max_depth) + " leaves mirror and glass " +
-                    (p.max_depth < 2 ? "black" : "dark") + ": what they reflect and refract needs -m 3 or more "
-                    "(-m 5 for glass seen through glass)");
+  if (std::string h = depth_hint(p.max_depth, f); !h.empty()) hints.push_back(h);
   if (p.spp == 1 && !(o.limits.target_error > 0))
     hints.push_back("-s 1 takes one sample a pixel, through its centre: expect jagged edges and heavy noise "
                     "(-s 64 or more, or --target-error 0.01)");

@@ -16,5 +16,7 @@ struct SceneFeatures;
 // `bounds`: the geometry bounds the course frames. Each hint names the flag that helps.
 std::vector<std::string> render_hints(const CliOptions& options, const SceneFeatures& features, const Camera& camera,
                                       const Bounds3& bounds, bool course_framing);
+// The hint for a max depth that leaves the scene's mirrors and glass black or dark, or "".
+std::string depth_hint(int max_depth, const SceneFeatures& features);
 
 }  // namespace pt

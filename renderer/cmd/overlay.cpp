@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 #include <utility>
 
@@ -127,20 +128,11 @@ std::vector<std::string> status_lines(const Status& st, const RenderParams& p, b
 }
 
 std::vector<std::string> key_lines() {
-  // window_keys_text's key column is padded for a terminal; the panel pads it to the longest key.
-  std::vector<std::pair<std::string, std::string>> rows;  // key ("" on a continuation line), text
+  // The brief form, the key column padded to the longest key: it fits a 320x240 window.
   size_t width = 0;
-  std::istringstream in(window_keys_text());
-  for (std::string l; std::getline(in, l);) {
-    size_t key = l.find_first_not_of(' ');
-    if (key == std::string::npos) continue;
-    size_t gap = key > 4 ? key : l.find("  ", key);  // deeper indents continue the line above
-    size_t text = gap == std::string::npos ? gap : l.find_first_not_of(' ', gap);
-    rows.push_back({l.substr(key, gap - key), text == std::string::npos ? "" : l.substr(text)});
-    width = std::max(width, rows.back().first.size());
-  }
+  for (const WindowKey& k : window_keys()) width = std::max(width, std::strlen(k.keys));
   std::vector<std::string> out;
-  for (auto& [key, text] : rows) out.push_back(key + std::string(width + 2 - key.size(), ' ') + text);
+  for (const WindowKey& k : window_keys()) out.push_back(k.keys + std::string(width + 2 - std::strlen(k.keys), ' ') + k.brief);
   return out;
 }
 

@@ -19,7 +19,7 @@ struct Rect {
 
 // The status panel's lines, most important first: a window too small for all shows the first.
 std::vector<std::string> status_lines(const Status& st, const RenderParams& p, bool current, bool rate_view);
-// The key list (window_keys_text) in the panel's compact form, for the H key.
+// The key list in the panel's brief form (window_keys), for the ? key.
 std::vector<std::string> key_lines();
 // Samples, progress and ETA in a few words ("spp 8/64 | ETA 3s, 12%"): the window title's status.
 std::string progress_text(const Status& st, bool current);

@@ -5,10 +5,8 @@
 // its cancel flag and start a new session; the window thread never waits on rendering.
 // The render size follows the window's framebuffer (course behaviour); until the new session's
 // first tiles arrive the previous image is stretched to the new size.
-// The status panel and the rate view's legend are drawn over the image (overlay.h); the title
-// keeps a short status for window managers. S and D write into --output-dir (default: the
-// current directory). --script replays window input from a file (viewer_script.h), so tests can
-// drive the real window under Xvfb.
+// The status panel and the rate view's legend are drawn over the image (overlay.h). S and D write
+// into --output-dir (default: the current directory). --script replays input (viewer_script.h).
 #include "viewer.h"
 
 #include <GLFW/glfw3.h>
@@ -20,8 +18,10 @@
 #include <cstdio>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <thread>
 
+#include "hints.h"
 #include "overlay.h"
 #include "scene_file.h"
 #include "session.h"
@@ -79,6 +79,7 @@ class Viewer {
     m_sh.want.width = std::min(std::max(1, fw), 16384);
     m_sh.want.height = std::min(std::max(1, fh), 16384);
     m_nav.reset(make_camera(m_desc, camera_params(m_sh.want)));
+    m_features = scene->features;
     if (m_options.params.cell_w > 0) say("window: -p is ignored; the window renders the whole frame");
     say("window: %dx%d, %s", m_sh.want.width, m_sh.want.height, settings_text(m_sh.want).c_str());
 
@@ -143,6 +144,11 @@ class Viewer {
     if (!text.empty()) say("%s", text.c_str());
   }
 
+  RenderParams want() {
+    std::lock_guard<std::mutex> lk(m_sh.mutex);
+    return m_sh.want;
+  }
+
   void push_command(const Command& c) {
     {
       std::lock_guard<std::mutex> lk(m_sh.mutex);
@@ -155,7 +161,11 @@ class Viewer {
 
   void on_key(int key, bool repeat) {
     if (key != GLFW_KEY_SLASH) set_show_keys(false);
-    if (is_setting_key(key)) change([key](RenderParams& p) { return apply_setting_key(key, p); });
+    if (is_setting_key(key)) {
+      change([key](RenderParams& p) { return apply_setting_key(key, p); });
+      const std::string hint = depth_hint(want().max_depth, m_features);  // said once, as the CLI's hints
+      if (!hint.empty() && m_hinted.insert(hint).second) say("hint: %s", hint.c_str());
+    }
     if (key == GLFW_KEY_ESCAPE || key == GLFW_KEY_Q) glfwSetWindowShouldClose(m_win, GLFW_TRUE);
     if (key == GLFW_KEY_R) change([](RenderParams&) { return std::string("restart"); });
     if (repeat) return;  // the keys below act once per press
@@ -273,15 +283,10 @@ class Viewer {
     if (m_resize_w <= 0 || m_resize_h <= 0 || ms_since(m_resize_at) < kResizeSettleMs) return;
     int w = std::min(m_resize_w, 16384), h = std::min(m_resize_h, 16384);
     m_resize_w = m_resize_h = 0;
-    bool same;
-    {
-      std::lock_guard<std::mutex> lk(m_sh.mutex);
-      same = m_sh.want.width == w && m_sh.want.height == h;
-    }
-    if (!same)
+    const RenderParams now = want();
+    if (now.width != w || now.height != h)
       change([w, h](RenderParams& p) {
-        p.width = w;
-        p.height = h;
+        p.width = w, p.height = h;
         return "size " + std::to_string(w) + "x" + std::to_string(h);
       });
   }
@@ -385,9 +390,7 @@ class Viewer {
       in.params = m_sh.want;
       in.current = in.status.gen == m_sh.want_gen;
     }
-    in.show_panel = m_show_panel;
-    in.show_keys = m_show_keys;
-    in.show_rate = m_show_rate;
+    in.show_panel = m_show_panel, in.show_keys = m_show_keys, in.show_rate = m_show_rate;
     in.have_image = m_tex_w > 0;
     if (m_show_rate && !m_count.empty()) {
       auto [lo, hi] = std::minmax_element(m_count.begin(), m_count.end());
@@ -522,6 +525,8 @@ class Viewer {
   int m_resize_w = 0, m_resize_h = 0;
   Clock::time_point m_resize_at;
   CameraNav m_nav;
+  SceneFeatures m_features;
+  std::set<std::string> m_hinted;
   bool m_previewing = false;  // rendering at 1/kPreviewScale while the camera moves
   int m_full_w = 0, m_full_h = 0;
   Clock::time_point m_moved_at;
