@@ -13,6 +13,7 @@
 
 #include "gltf.h"
 #include "render_scene.h"
+#include "session.h"
 
 namespace pt::test {
 
@@ -115,6 +116,22 @@ struct GltfDoc {
     return out;
   }
 };
+
+// A glTF document rendered at 48x48 (no adaptive sampling, 2 threads, `seed`), checked for NaN.
+inline ImageRGB render_gltf(const std::string& text, int spp, int depth, uint64_t seed = 0) {
+  RenderParams p;
+  p.width = p.height = 48;
+  p.spp = spp;
+  p.max_depth = depth;
+  p.adaptive = false;
+  p.threads = 2;
+  p.seed = seed;
+  auto scene = make_render_scene(parse_gltf(text, "t.gltf", false), p);
+  RenderSession s(*scene, p);
+  s.render_all();
+  EXPECT_EQ(s.stats().nonfinite, 0u);
+  return s.image();
+}
 
 // What a white Lambertian quad facing +z reflects under the default light (an unlit glTF scene's):
 // the environment's radiance plus the sun's irradiance x cos / pi.

@@ -19,19 +19,7 @@ using test::RegionStats;
 
 namespace {
 
-ImageRGB render(const std::string& text, int spp, int depth) {
-  RenderParams p;
-  p.width = p.height = 48;
-  p.spp = spp;
-  p.max_depth = depth;
-  p.adaptive = false;
-  p.threads = 2;
-  auto scene = make_render_scene(parse_gltf(text, "t.gltf", false), p);
-  RenderSession s(*scene, p);
-  s.render_all();
-  EXPECT_EQ(s.stats().nonfinite, 0u);
-  return s.image();
-}
+ImageRGB render(const std::string& text, int spp, int depth) { return test::render_gltf(text, spp, depth); }
 
 // The mean of each quarter's inner square (10 pixels off the centre).
 constexpr int kHalf = 24, kR = 4;

@@ -18,19 +18,7 @@ using test::RegionStats;
 
 namespace {
 
-ImageRGB render(const std::string& text, int spp, int depth) {
-  RenderParams p;
-  p.width = p.height = 48;
-  p.spp = spp;
-  p.max_depth = depth;
-  p.adaptive = false;
-  p.threads = 2;
-  auto scene = make_render_scene(parse_gltf(text, "t.gltf", false), p);
-  RenderSession s(*scene, p);
-  s.render_all();
-  EXPECT_EQ(s.stats().nonfinite, 0u);
-  return s.image();
-}
+ImageRGB render(const std::string& text, int spp, int depth) { return test::render_gltf(text, spp, depth); }
 
 RegionStats centre(const ImageRGB& img, int c) { return region_stats(img, 16, 16, 32, 32, c); }
 

@@ -22,18 +22,7 @@ using test::RegionStats;
 namespace {
 
 ImageRGB render(const std::string& text, int spp, int depth, uint64_t seed = 0) {
-  RenderParams p;
-  p.width = p.height = 48;
-  p.spp = spp;
-  p.max_depth = depth;
-  p.adaptive = false;
-  p.threads = 2;
-  p.seed = seed;
-  auto scene = make_render_scene(parse_gltf(text, "t.gltf", false), p);
-  RenderSession s(*scene, p);
-  s.render_all();
-  EXPECT_EQ(s.stats().nonfinite, 0u);
-  return s.image();
+  return test::render_gltf(text, spp, depth, seed);
 }
 
 // The quad (test::quad_doc) with uvs running as an image's (u along +x, v down +y: (0, 0) at the
