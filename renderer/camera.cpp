@@ -1,6 +1,7 @@
 // Camera placement (course framing, authored, or a settings file) and ray generation.
 #include "camera.h"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -188,6 +189,14 @@ Camera make_camera(const CameraDesc& authored, const Bounds3& b, const CameraPar
   } else if (course_framing && p.keep_fov) {
     c.screen_distance *= float(p.width) / 800.0f;
   }
+  if (p.pose.set) {
+    // A pose places the camera wherever the framing put it: the file's clip range no longer
+    // applies, and the framing's field of view stays unless the pose gives one.
+    c = camera_looking(c, p.pose.position, p.pose.target, p.pose.up);
+    if (p.pose.vfov_deg > 0) c.screen_distance = float(p.height) / (2 * std::tan(0.5f * p.pose.vfov_deg * kDeg));
+    c.tmin = 0;
+    c.tmax = kInf;
+  }
   c.tan_half_w = (0.5f * p.width) / c.screen_distance;
   c.tan_half_h = (0.5f * p.height) / c.screen_distance;
   return c;
@@ -259,13 +268,32 @@ bool Camera::sensor_point(Vec3 p, Vec2 lens_u, float& sx, float& sy, Vec3& origi
   return std::isfinite(sx) && std::isfinite(sy);
 }
 
-Camera camera_looking(Camera c, Vec3 position, Vec3 target) {
+Camera camera_looking(Camera c, Vec3 position, Vec3 target, Vec3 up) {
   const Vec3 back = position - target;
   if (!(length(back) > 0) || !is_finite(back)) return c;
   c.position = position;
   c.target = target;
-  set_basis(c, back, Vec3(0, 1, 0));
+  set_basis(c, back, up);
   return c;
+}
+
+float vertical_fov_deg(const Camera& c) { return 2 * std::atan(c.tan_half_h) / kDeg; }
+
+std::string pose_error(const CameraPose& p) {
+  // Past 1e7 a float keeps under a unit of precision: positions that far are typos, not scenes.
+  constexpr float kFar = 1e7f;
+  auto bad = [&](Vec3 v) { return !is_finite(v) || std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > kFar; };
+  if (bad(p.position)) return "position: each coordinate must be finite and within 1e7";
+  if (bad(p.target)) return "target: each coordinate must be finite and within 1e7";
+  if (bad(p.up)) return "up: each coordinate must be finite and within 1e7";
+  const float scale = std::max({1.0f, length(p.position), length(p.target)});
+  const Vec3 view = p.position - p.target;
+  if (!(length(view) > 1e-5f * scale)) return "target: must differ from the position";
+  if (!(length(p.up) > 0)) return "up: must not be zero";
+  if (!(length(cross(normalize(p.up), normalize(view))) > 1e-3f)) return "up: must not be parallel to the view direction";
+  if (p.vfov_deg != 0 && !(p.vfov_deg >= kMinPoseFov && p.vfov_deg <= kMaxPoseFov))
+    return "vfov: must be between 0.1 and 179 degrees";
+  return "";
 }
 
 void write_camera_settings(const Camera& c, const std::string& path) {

@@ -13,6 +13,18 @@ namespace pt {
 // table, Camera) is this one.
 constexpr double kCourseFocalDistance = 4.7;
 
+// An explicit pose (the job service's camera field): it replaces the framing's position and
+// orientation, and a vertical field of view > 0 replaces its field of view.
+struct CameraPose {
+  bool set = false;
+  Vec3 position, target, up{0, 1, 0};
+  float vfov_deg = 0;  // 0: the framing's
+};
+// Why `pose` cannot place a camera, naming the part ("position: ..."), or "" when it can.
+std::string pose_error(const CameraPose& pose);
+// The vertical field of view a pose may ask for, in degrees.
+constexpr float kMinPoseFov = 0.1f, kMaxPoseFov = 179;
+
 struct CameraParams {
   int width = 800, height = 600;   // full frame in pixels (-r)
   float lens_radius = 0;           // -b; 0 is a pinhole
@@ -21,6 +33,7 @@ struct CameraParams {
   bool keep_fov = false;           // -r scales the course's 800x600 view instead of cropping it
   bool frame_scene = false;        // the course's view direction, the field of view fitted to the bounds
   std::string settings_file;       // -c: course camera settings file
+  CameraPose pose;                 // applied after the framing when set
 };
 
 struct Camera {
@@ -52,9 +65,12 @@ struct Camera {
   bool sensor_point(Vec3 p, Vec2 lens_u, float& sx, float& sy, Vec3& origin) const;
 };
 
-// `c` moved to look from `position` at `target` with world up +Y, its field of view, size and lens
-// kept: what the window's orbit, pan and dolly show. A pose with position == target keeps c.
-Camera camera_looking(Camera c, Vec3 position, Vec3 target);
+// `c` moved to look from `position` at `target` with `up` (world +Y by default), its field of view,
+// size and lens kept: what the window's orbit, pan and dolly show. A pose with position == target
+// keeps c.
+Camera camera_looking(Camera c, Vec3 position, Vec3 target, Vec3 up = Vec3(0, 1, 0));
+// The camera's vertical field of view in degrees.
+float vertical_fov_deg(const Camera& camera);
 
 // Builds the camera; throws std::runtime_error naming the settings file on a bad -c file.
 Camera make_camera(const SceneDesc& scene, const CameraParams& params);

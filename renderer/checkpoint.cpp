@@ -81,6 +81,12 @@ std::string render_fingerprint(const std::string& scene_bytes, const RenderParam
   }
   f << ", sampler " << int(p.sampler) << ", environment '" << p.env_map << "', camera file '" << p.camera_file
     << "', cell " << p.cell_x << " " << p.cell_y << " " << p.cell_w << " " << p.cell_h;
+  if (p.camera.set) {
+    const CameraPose& c = p.camera;
+    f.precision(9);  // a float's every digit: two poses a hair apart are two films
+    f << ", camera " << c.position.x << " " << c.position.y << " " << c.position.z << " " << c.target.x << " "
+      << c.target.y << " " << c.target.z << " " << c.up.x << " " << c.up.y << " " << c.up.z << " " << c.vfov_deg;
+  }
   return f.str();
 }
 

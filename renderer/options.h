@@ -31,6 +31,7 @@ struct RenderParams {
   bool file_camera = false;        // --file-camera: the scene's camera as authored
   bool keep_fov = false;           // --keep-fov: -r scales the course's view instead of cropping it
   bool frame_scene = false;        // --frame-scene: the course's view direction, zoomed to fit the scene
+  CameraPose camera;               // --camera / a job's camera field: an explicit pose after the framing
   int cell_x = 0, cell_y = 0, cell_w = 0, cell_h = 0;  // -p: window, bottom-left origin; w = 0: full frame
   uint64_t seed = 0;               // --seed
   int tile_size = 32;

@@ -49,6 +49,10 @@ void RenderParams::validate() const {
     if (cell_w < 1 || cell_h < 1 || cell_x < 0 || cell_y < 0 || cell_x + cell_w > width || cell_y + cell_h > height)
       bad("cell (-p)", "x y dx dy must lie inside the " + std::to_string(width) + "x" + std::to_string(height) + " frame");
   }
+  if (camera.set) {
+    const std::string why = pose_error(camera);
+    if (!why.empty()) bad("camera." + why.substr(0, why.find(':')) + " (--camera)", why.substr(why.find(':') + 2));
+  }
 }
 
 CameraParams camera_params(const RenderParams& params) {
@@ -61,6 +65,7 @@ CameraParams camera_params(const RenderParams& params) {
   cp.keep_fov = params.keep_fov;
   cp.frame_scene = params.frame_scene;
   cp.settings_file = params.camera_file;
+  cp.pose = params.camera;
   return cp;
 }
 

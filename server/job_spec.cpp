@@ -53,7 +53,78 @@ struct Reader {
   }
 };
 
+// The shortest decimal that reads back as the same float (0.1f is 0.1, not 0.100000001).
+double shortest(float v) {
+  char buf[32];
+  for (int digits = 6; digits <= 9; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, double(v));
+    if (std::strtof(buf, nullptr) == v) break;
+  }
+  return std::strtod(buf, nullptr);
+}
+
+json vec3_json(pt::Vec3 v) { return json::array({shortest(v.x), shortest(v.y), shortest(v.z)}); }
+
+pt::Vec3 read_vec3(const json& v, const std::string& field) {
+  if (!v.is_array() || v.size() != 3)
+    throw JobError(JobErrorKind::invalid, "'" + field + "' must be an array of three numbers [x, y, z]", field);
+  float xyz[3];
+  for (int i = 0; i < 3; ++i) {
+    if (!v[i].is_number()) throw JobError(JobErrorKind::invalid, "'" + field + "' must hold three numbers", field);
+    const double x = v[i].get<double>();
+    if (!std::isfinite(x) || std::fabs(x) > 1e7)
+      throw JobError(JobErrorKind::invalid, "'" + field + "': each coordinate must be finite and within 1e7", field);
+    xyz[i] = float(x);
+  }
+  return pt::Vec3(xyz[0], xyz[1], xyz[2]);
+}
+
 }  // namespace
+
+pt::CameraPose parse_camera(const json& cam) {
+  if (!cam.is_object())
+    throw JobError(JobErrorKind::invalid, "'camera' must be an object {position, target, up, vfov}", "camera");
+  for (auto it = cam.begin(); it != cam.end(); ++it)
+    if (it.key() != "position" && it.key() != "target" && it.key() != "up" && it.key() != "vfov")
+      throw JobError(JobErrorKind::invalid, "unknown field 'camera." + it.key() + "' (position, target, up, vfov)",
+                     "camera." + it.key());
+  pt::CameraPose pose;
+  pose.set = true;
+  for (const char* need : {"position", "target"})
+    if (!cam.contains(need) || cam[need].is_null())
+      throw JobError(JobErrorKind::invalid, std::string("'camera.") + need + "' is required", std::string("camera.") + need);
+  pose.position = read_vec3(cam["position"], "camera.position");
+  pose.target = read_vec3(cam["target"], "camera.target");
+  if (cam.contains("up") && !cam["up"].is_null()) pose.up = read_vec3(cam["up"], "camera.up");
+  if (cam.contains("vfov") && !cam["vfov"].is_null()) {
+    const json& f = cam["vfov"];
+    const double v = f.is_number() ? f.get<double>() : -1;
+    if (!(v >= pt::kMinPoseFov && v <= pt::kMaxPoseFov))
+      throw JobError(JobErrorKind::invalid, "'camera.vfov' must be a number between 0.1 and 179 (degrees)", "camera.vfov");
+    pose.vfov_deg = float(v);
+  }
+  const std::string why = pt::pose_error(pose);  // "part: why"
+  if (!why.empty()) {
+    const std::string part = "camera." + why.substr(0, why.find(':'));
+    throw JobError(JobErrorKind::invalid, "'" + part + "'" + why.substr(why.find(':')), part);
+  }
+  return pose;
+}
+
+json camera_pose_json(const pt::CameraPose& pose) {
+  if (!pose.set) return nullptr;
+  return {{"position", vec3_json(pose.position)},
+          {"target", vec3_json(pose.target)},
+          {"up", vec3_json(pose.up)},
+          {"vfov", pose.vfov_deg > 0 ? json(shortest(pose.vfov_deg)) : json(nullptr)}};
+}
+
+json view_json(const pt::Camera& c) {
+  return {{"position", vec3_json(c.position)},
+          {"target", vec3_json(c.target)},
+          {"up", vec3_json(c.up)},
+          {"vfov", shortest(pt::vertical_fov_deg(c))}};
+}
 
 std::pair<double, double> job_range(const pt::RenderOption& o, const SpecLimits& lim) {
   std::string name = o.name;
@@ -99,6 +170,10 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
     s.scene = scene->get<std::string>();
     if (!valid_scene_name(s.scene))
       throw JobError(JobErrorKind::invalid, "'scene' must be a scene name (letters, digits, '_', '-', '.'; no paths)", "scene");
+  });
+  check([&] {
+    const json* cam = r.get("camera");
+    if (cam) p.camera = parse_camera(*cam);
   });
   pt::RunLimits run;
   for (const pt::RenderOption& o : pt::render_options()) {  // every field from the one table
@@ -153,12 +228,14 @@ json job_spec_to_json(const JobSpec& s) {
       case pt::OptionType::boolean: j[o.name] = v != 0; break;
     }
   }
+  j["camera"] = camera_pose_json(s.params.camera);
   return j;
 }
 
 json job_spec_defaults() {
   json j = job_spec_to_json(parse_job_spec(json{{"scene", "default"}}));
   j.erase("scene");
+  j.erase("camera");  // not a scalar: the OpenAPI document describes it
   return j;
 }
 

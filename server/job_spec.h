@@ -71,6 +71,13 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& limits = {});
 json job_spec_to_json(const JobSpec& spec);
 // A render option's range for jobs: its own, narrowed by the server's policy.
 std::pair<double, double> job_range(const pt::RenderOption& option, const SpecLimits& limits);
+// A job's camera field {position, target, up = [0, 1, 0], vfov = the framing's}; throws
+// JobError(invalid) naming the part ("camera.up").
+pt::CameraPose parse_camera(const json& camera);
+// A job's camera field (null when the job has none) and a resolved camera as the job status shows
+// it ({position, target, up, vfov}, vfov in degrees).
+json camera_pose_json(const pt::CameraPose& pose);
+json view_json(const pt::Camera& camera);
 // The defaults and limits, as the API documents them.
 json job_spec_defaults();
 bool valid_scene_name(const std::string& name);

@@ -170,6 +170,7 @@ std::pair<std::shared_ptr<Job>, bool> JobManager::submit(const json& body, const
   job->id = new_job_id();
   job->spec = spec;
   job->scene_hash = scene_hash;
+  job->view = view_json(m_scenes.view(spec.scene, spec.params));
   job->warnings = std::move(warnings);
   job->idempotency_key = key;
   job->created_at = now_unix_seconds();
@@ -229,6 +230,7 @@ json JobManager::status_json(const Job& j, bool with_history) const {
          {"tile_size", j.spec.params.tile_size},
          {"stream_tile_size", stream_tile_size(j.spec.params.tile_size)},
          {"features", j.features},
+         {"view", j.view},
          {"warnings", j.warnings},
          {"images", {{"png", "/api/jobs/" + j.id + "/image.png"}, {"exr", "/api/jobs/" + j.id + "/image.exr"}}},
          {"events", "/api/jobs/" + j.id + "/events"}};
@@ -343,6 +345,10 @@ void JobManager::load_persisted() {
         if (doc.contains("features"))
           for (const json& f : doc["features"])
             if (f.is_string()) job->features.push_back(to_valid_utf8(f.get<std::string>()));
+        try {  // the camera it rendered from, checked as a camera field is
+          if (doc.contains("view") && !doc["view"].is_null()) job->view = camera_pose_json(parse_camera(doc["view"]));
+        } catch (const JobError&) {
+        }
         job->width = job->spec.params.width;
         job->height = job->spec.params.height;
         if (doc.contains("scene_hash") && doc["scene_hash"].is_number_unsigned()) job->scene_hash = doc["scene_hash"];
@@ -470,6 +476,7 @@ void JobManager::store_images(Job& job, const RenderResult& result) {
                     {"pathtracer:nonfinite_samples", std::to_string(r.nonfinite)},
                     {"pathtracer:stopped", pt::stop_reason_name(result.why)},
                     {"pathtracer:backend", m_backend->name()}};
+  if (!job.view.is_null()) meta.push_back({"pathtracer:view", dump_json(job.view)});  // whatever framed it
   try {
     retry_without_descriptors([&] { pt::write_image(img, job_dir(job.id) + "/image.exr", meta); });
     retry_without_descriptors([&] { pt::write_image(img, job_dir(job.id) + "/image.png"); });

@@ -61,6 +61,7 @@ struct Job {
   uint64_t checkpoint_samples = 0;  // what the job's checkpoint holds (a restart shows these)
   double checkpoint_seconds = 0;
   std::vector<std::string> features;
+  json view;  // the camera it renders from, as view_json writes it (null: not known)
   std::vector<std::string> warnings;  // what the scene's loader ignored or defaulted (its summary's)
 
   // The live image: linear RGB and its 8-bit display version. Clients are sent it in regions of at

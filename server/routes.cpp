@@ -91,7 +91,8 @@ void delete_scene(JobManager& jobs, const ApiOptions&, const Request& req, Respo
 
 void check_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {
   JobSpec spec = jobs.check(parse_body(req));
-  send_json(res, 200, {{"valid", true}, {"spec", job_spec_to_json(spec)}});
+  send_json(res, 200, {{"valid", true}, {"spec", job_spec_to_json(spec)},
+                       {"view", view_json(jobs.scenes().view(spec.scene, spec.params))}});
 }
 
 void submit_job(JobManager& jobs, const ApiOptions&, const Request& req, Response& res) {

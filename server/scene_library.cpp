@@ -150,11 +150,13 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
   // the scene, not the server's paths.
   Base base;
   json summary;
+  Framing framing;
   try {
     auto t0 = std::chrono::steady_clock::now();
     pt::SceneDesc desc = pt::parse_scene(bytes, pt::scene_file_name(name, bytes));
     std::string().swap(bytes);
     summary = summarize_desc(desc);
+    framing = Framing{desc.camera, desc.geometry_bounds()};
     base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(desc));
     desc = pt::SceneDesc();  // from here on only the base holds the scene
     double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -175,6 +177,7 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
     auto it = m_cache.find(hash);
     if (it != m_cache.end() && it->second.build_id == build_id) {
       it->second.summary = summary;
+      it->second.framing = framing;
       it->second.bytes = std::max<size_t>(1, base->memory_bytes());
     }
     evict_over_budget(hash, dropped);
@@ -235,7 +238,7 @@ SceneLibrary::FileSummary SceneLibrary::file_summary(const std::string& name) {
   FileSummary cached;
   cached.stamp = stamp;
   try {
-    cached.summary = summary(name, &cached.hash);
+    cached.summary = summary(name, &cached.hash, &cached.framing);
   } catch (const std::exception& e) {  // JobError too: a name whose file cannot be read
     cached.error = e.what();
   }
@@ -256,6 +259,16 @@ uint64_t SceneLibrary::check(const std::string& name, std::vector<std::string>* 
 }
 
 json SceneLibrary::summary(const std::string& name, uint64_t* content_hash) {
+  return summary(name, content_hash, nullptr);
+}
+
+pt::Camera SceneLibrary::view(const std::string& name, const pt::RenderParams& params) {
+  check(name);
+  const FileSummary file = file_summary(name);
+  return pt::make_camera(file.framing.camera, file.framing.bounds, pt::camera_params(params));
+}
+
+json SceneLibrary::summary(const std::string& name, uint64_t* content_hash, Framing* framing) {
   uint64_t hash = 0;
   std::string bytes = read_scene(name, &hash);
   if (content_hash) *content_hash = hash;
@@ -264,13 +277,22 @@ json SceneLibrary::summary(const std::string& name, uint64_t* content_hash) {
     std::lock_guard<std::mutex> lock(m_mutex);
     m_last_hash[name] = hash;
     auto it = m_cache.find(hash);
-    if (it != m_cache.end()) summary = it->second.summary;
+    if (it != m_cache.end()) {
+      summary = it->second.summary;
+      if (framing) *framing = it->second.framing;
+    }
     forget_unused();
   }
   if (summary.is_null()) {  // parsed for its summary only: the base is built by the first job
-    summary = summarize_desc(pt::parse_scene(bytes, pt::scene_file_name(name, bytes)));
+    const pt::SceneDesc desc = pt::parse_scene(bytes, pt::scene_file_name(name, bytes));
+    summary = summarize_desc(desc);
+    const Framing parsed{desc.camera, desc.geometry_bounds()};
+    if (framing) *framing = parsed;
     std::lock_guard<std::mutex> lock(m_mutex);
-    if (m_last_hash[name] == hash) m_cache[hash].summary = summary;
+    if (m_last_hash[name] == hash) {
+      m_cache[hash].summary = summary;
+      m_cache[hash].framing = parsed;
+    }
   }
   return summary;
 }

@@ -50,6 +50,9 @@ class SceneLibrary {
   // file it has not seen but builds nothing, so it also validates cheaply. Throws as load() does.
   // `content_hash`, when given, receives the hash of the file's content the summary is of.
   json summary(const std::string& name, uint64_t* content_hash = nullptr);
+  // The camera a job with `params` renders the scene from (its framing, or the params' pose),
+  // without building the scene. Throws as check() does.
+  pt::Camera view(const std::string& name, const pt::RenderParams& params);
   // Every scene with its summary, or its load error, and the bytes of its built base while the
   // cache holds one.
   json list();
@@ -63,8 +66,15 @@ class SceneLibrary {
 
  private:
   using Base = std::shared_ptr<const pt::SceneBase>;
+  // What the course framing reads of a file: its camera and the geometry bounds.
+  struct Framing {
+    pt::CameraDesc camera;
+    pt::Bounds3 bounds;
+  };
+  json summary(const std::string& name, uint64_t* content_hash, Framing* framing);
   struct Entry {
     json summary;                   // null until the content was parsed once
+    Framing framing;                // with the summary
     std::shared_future<Base> base;  // valid once a build started; ready when it ended
     uint64_t build_id = 0;          // which load() is building it
     size_t bytes = 0;               // the built base's memory_bytes(); 0 until built
@@ -90,6 +100,7 @@ class SceneLibrary {
   struct FileSummary {
     FileStamp stamp;
     json summary;       // when it loads
+    Framing framing;    // with the summary
     std::string error;  // when it does not
     uint64_t hash = 0;
   };

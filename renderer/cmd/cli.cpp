@@ -147,6 +147,17 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
     else if (a == "--target-error") { need(a, 1); o.limits.target_error = parse_option(a, "target_error", args[++i]); }
     else if (a == "--time-limit") { need(a, 1); o.limits.time_limit = parse_option(a, "time_limit", args[++i]); }
     else if (a == "--file-camera") { p.file_camera = true; }
+    else if (a == "--camera") {
+      // The job service's camera field on the command line: position, target, vertical FOV (0: the
+      // framing's); up is world +Y.
+      need(a, 7);
+      float v[7];
+      for (float& x : v) x = float(parse_float(a, args[++i], -1e7, 1e7));
+      p.camera.set = true;
+      p.camera.position = Vec3(v[0], v[1], v[2]);
+      p.camera.target = Vec3(v[3], v[4], v[5]);
+      p.camera.vfov_deg = v[6];
+    }
     else if (a == "--seed") { need(a, 1); p.seed = uint64_t(parse_option(a, "seed", args[++i])); }
     else if (a == "--tile") { need(a, 1); p.tile_size = int(parse_option(a, "tile_size", args[++i])); }
     else if (a == "--quiet") { o.quiet = true; }
@@ -222,6 +233,8 @@ std::string usage_text(const std::string& program) {
 "  --quiet         no progress bar\n"
 "  --keep-fov      -r scales the course's 800x600 view to the output size instead of cropping it\n"
 "  --frame-scene   the course's view direction, zoomed so the scene's bounds fill the image\n"
+"  --camera <PX> <PY> <PZ> <TX> <TY> <TZ> <VFOV>  look from P at T (up +Y) with this vertical\n"
+"                  field of view in degrees (0: the framing's), as a job's camera field\n"
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
 "  --no-default-light    no white environment for a glTF scene without lights or emitters\n"
@@ -309,6 +322,17 @@ Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
                {"pathtracer:error_estimate", num(session.error_estimate())},
                {"pathtracer:nonfinite_samples", std::to_string(st.nonfinite)}};
   meta.insert(meta.end(), run.begin(), run.end());
+  // The camera it rendered from, whatever framed it: --camera with these numbers renders it again.
+  const Camera& c = session.scene().camera;
+  auto exact = [](std::initializer_list<float> values) {
+    std::ostringstream s;
+    s.precision(9);
+    for (float v : values) s << (s.tellp() > 0 ? " " : "") << v;
+    return s.str();
+  };
+  meta.push_back({"pathtracer:view", "position " + exact({c.position.x, c.position.y, c.position.z}) + " target " +
+                                         exact({c.target.x, c.target.y, c.target.z}) + " vfov " +
+                                         exact({vertical_fov_deg(c)})});
   return meta;
 }
 

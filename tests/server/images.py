@@ -177,6 +177,10 @@ def cli_args(spec, threads=2):
         args.append("--keep-fov")
     if not spec.get("caustic_tracing", True):
         args.append("--no-caustic-tracing")
+    cam = spec.get("camera")
+    if cam:  # the CLI's --camera has world up
+        assert cam.get("up") in (None, [0, 1, 0]), "the CLI's --camera has no up vector"
+        args += ["--camera", *map(repr, cam["position"]), *map(repr, cam["target"]), repr(cam.get("vfov") or 0)]
     return args
 
 

@@ -32,11 +32,12 @@ def test_component_schemas_are_valid(contract):
 def test_defaults_match_the_server(server, contract):
     body = server.api.get("/api/scenes").json()
     documented = contract.doc["components"]["schemas"]["JobSpec"]["properties"]
-    assert set(documented) == set(body["defaults"]) | {"scene"}
+    # The camera is an object without a default value: absent, the scene's own framing.
+    assert set(documented) == set(body["defaults"]) | {"scene", "camera"}
     for field, value in body["defaults"].items():
         assert documented[field]["default"] == value, field
     checked = server.api.post("/api/jobs/check", {"scene": "cornell"}, expect=200).json()["spec"]
-    assert checked == dict(body["defaults"], scene="cornell")
+    assert checked == dict(body["defaults"], scene="cornell", camera=None)
 
 
 def field_cases(contract):

@@ -244,3 +244,26 @@ def test_a_worker_builds_a_scene_once_for_every_job_of_that_content(cluster):
     assert srv.api.wait(job_id, {"done", "failed"}, timeout=60)["state"] == "done"
     builds = [line for line in workers[0].text().splitlines() if "built in" in line]
     assert len(builds) == 2, builds
+
+
+def test_a_camera_field_reaches_the_worker(cluster, servers):
+    """A job's pose travels with its spec through Redis: the worker renders the view the job shows,
+    the same image as an embedded server's."""
+    srv, workers, redis = cluster(1)
+    spec = dict(JOB, spp=4, width=64, height=48, camera={"position": [2.5, 1.2, 3.0], "target": [0, 0.4, 0], "vfov": 40})
+    job_id = srv.api.submit(spec)["id"]
+    done = srv.api.wait(job_id, {"done", "failed"}, timeout=90)
+    assert done["state"] == "done" and done["view"]["position"] == [2.5, 1.2, 3.0] and done["view"]["vfov"] == 40
+    single = servers("single_camera", threads=2)
+    ref_id = single.api.submit(spec)["id"]
+    assert single.api.wait(ref_id, {"done", "failed"}, timeout=90)["state"] == "done"
+    _, _, dist, attrs = image(srv.api, job_id)
+    _, _, ref, _ = image(single.api, ref_id)
+    assert attrs["pathtracer:backend"] == redis.url
+    worst = max(abs(a - b) / (abs(b) + 1e-3) for c in "RGB" for a, b in zip(dist[c], ref[c]))
+    assert worst < 1e-3, f"the worker's view differs from the embedded server's by up to {worst:.2e}"
+    # And it is not the scene's own framing.
+    framed_id = single.api.submit(dict(spec, camera=None))["id"]
+    assert single.api.wait(framed_id, {"done", "failed"}, timeout=90)["state"] == "done"
+    _, _, framed, _ = image(single.api, framed_id)
+    assert sum(abs(a - b) for a, b in zip(framed["G"], ref["G"])) > 0.05 * sum(ref["G"])
