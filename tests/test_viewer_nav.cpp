@@ -93,3 +93,41 @@ TEST_F(Viewer, TheMovedCameraRendersTheSameImageFromItsSettingsFile) {
   EXPECT_LT(mean_abs_diff_levels(m_dir + "/window.png", m_dir + "/cli.png"), 0.5) << w.output;
   EXPECT_GT(mean_abs_diff_levels(m_dir + "/window.png", m_dir + "/unmoved.png"), 5.0) << "the drag moved nothing";
 }
+
+// C: the course's cell mode. A left drag's rubber band becomes the -p cell the render redoes,
+// painted over the image the window shows: a setting changed in cell mode changes only the cell,
+// which is the CLI's -p render of it; C again renders the whole frame.
+TEST_F(Viewer, CellModeRendersTheRubberBandsRectangleOnly) {
+  const std::string flags = "-t 2 -s 16 -m 3 -r 120 90 --seed 3";
+  RunResult r = run_window(flags, "key `\nwait_spp 16\nscreenshot " + m_dir + "/full.png\nkey C\ndrag left 30 20 70 50 4\n"
+                           "key ,\nkey ,\nkey ,\nwait_spp 16\nscreenshot " + m_dir + "/cell.png\nkey C\nwait_spp 16\n"
+                           "screenshot " + m_dir + "/after.png\nquit\n");
+  ASSERT_EQ(r.status, 0) << r.output;
+  // (30, 20)..(70, 50) in a 120x90 window: columns 30..69, rows 20..49 from the top; -p counts
+  // from the bottom-left, so the cell starts at row 90 - 50 = 40.
+  for (const char* said : {"cell mode: on", "cell: 30 40 40 30", "cell mode: off", "cell: whole frame"})
+    EXPECT_NE(r.output.find(said), std::string::npos) << said << "\n" << r.output;
+  RunResult c = run(flags + " -m 0 -p 30 40 40 30 --quiet -f " + m_dir + "/cli_cell.png " + m_scene);
+  ASSERT_EQ(c.status, 0) << c.output;
+  const ImageRGB full = read_image(m_dir + "/full.png"), cell = read_image(m_dir + "/cell.png");
+  const ImageRGB after = read_image(m_dir + "/after.png"), cli = read_image(m_dir + "/cli_cell.png");
+  ASSERT_EQ(cell.width, 120);
+  ASSERT_EQ(cli.width, 40);
+  auto levels = [](Vec3 a, Vec3 b) { return (std::abs(a.x - b.x) + std::abs(a.y - b.y) + std::abs(a.z - b.z)) * 255 / 3; };
+  double outside_kept = 0, inside_cli = 0, outside_after = 0;
+  int n_out = 0;
+  for (int y = 0; y < 90; ++y)
+    for (int x = 0; x < 120; ++x) {
+      const size_t i = size_t(y) * 120 + x;
+      if (x >= 30 && x < 70 && y >= 20 && y < 50) {
+        inside_cli += levels(cell.pixels[i], cli.pixels[size_t(y - 20) * 40 + (x - 30)]);
+      } else {  // the panel is hidden (`), the band drawn only while dragging
+        outside_kept += levels(cell.pixels[i], full.pixels[i]);
+        outside_after += levels(after.pixels[i], full.pixels[i]);
+        ++n_out;
+      }
+    }
+  EXPECT_LT(inside_cli / (40 * 30), 0.5) << "the cell is not the CLI's -p render at depth 0";
+  EXPECT_LT(outside_kept / n_out, 0.5) << "outside the cell the image changed";
+  EXPECT_GT(outside_after / n_out, 5.0) << "leaving cell mode did not render the whole frame at depth 0";
+}

@@ -280,6 +280,7 @@ const std::vector<WindowKey>& window_keys() {
       {"right drag", "pan", "pan camera and target in the view plane"},
       {"wheel", "dolly", "dolly towards / away from the target"},
       {"Space", "initial camera", "back to the initial camera"},
+      {"C", "cell mode", "cell mode: a left drag's rectangle is rendered alone (-p); C again: whole frame"},
       {"H (or `)", "panel on / off", "show / hide the status panel (samples, error, ETA, settings)"},
       {"? (/)", "these keys", "list these keys (in the panel and on stdout)"},
       {"Esc / Q", "quit", "quit"},

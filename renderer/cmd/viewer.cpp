@@ -1,12 +1,11 @@
 // The GLFW debug window: a render thread (viewer_loop.h) runs RenderSession passes of doubling
 // sample targets and hands finished tiles (tone-mapped exactly like the PNG) to the window thread,
-// which uploads them into one texture drawn as a full-window quad (OpenGL 1.x/2.1 calls only, so
-// Mesa's llvmpipe under Xvfb runs it). Keys change RenderParams, cancel the running pass through
-// its cancel flag and start a new session; the window thread never waits on rendering.
-// The render size follows the window's framebuffer (course behaviour); until the new session's
-// first tiles arrive the previous image is stretched to the new size.
-// The status panel and the rate view's legend are drawn over the image (overlay.h). S and D write
-// into --output-dir (default: the current directory). --script replays input (viewer_script.h).
+// which uploads them into one texture drawn as a full-window quad (viewer_gl.h). Keys change
+// RenderParams, cancel the running pass through its cancel flag and start a new session; the
+// window thread never waits on rendering. The render size follows the window's framebuffer (course
+// behaviour); until the new session's first tiles arrive the previous image is stretched to it.
+// The status panel and the rate legend are drawn over the image (overlay.h). S and D write into
+// --output-dir (default: the current directory). --script replays input (viewer_script.h).
 #include "viewer.h"
 
 #include <GLFW/glfw3.h>
@@ -25,6 +24,7 @@
 #include "overlay.h"
 #include "scene_file.h"
 #include "session.h"
+#include "viewer_gl.h"
 #include "viewer_keys.h"
 #include "viewer_loop.h"
 #include "viewer_script.h"
@@ -177,6 +177,13 @@ class Viewer {
         break;
       case GLFW_KEY_S: push_command({CommandKind::save}); break;
       case GLFW_KEY_D: write_camera(); break;
+      case GLFW_KEY_C:
+        m_cell_mode = !m_cell_mode;
+        m_band.cancel();
+        say("cell mode: %s", m_cell_mode ? "on (drag a rectangle to render only it)" : "off");
+        if (!m_cell_mode) clear_cell();
+        m_dirty = true;
+        break;
       case GLFW_KEY_SPACE:
         m_nav.home();
         moved_view();
@@ -215,6 +222,7 @@ class Viewer {
   // ---- camera navigation (viewer_nav.h) ----
 
   void on_button(CameraNav::Button b, bool down, double x, double y) {
+    if (m_cell_mode && b == CameraNav::left) return cell_button(down, x, y);
     if (down) return m_nav.press(b, x, y);
     const bool dragged = m_nav.dragging();
     if (m_nav.release(x, y)) on_click(x, y);  // a click focuses, as before
@@ -222,6 +230,11 @@ class Viewer {
   }
 
   void on_cursor(double x, double y) {
+    if (m_band.active()) {
+      m_band.move(x, y);
+      m_dirty = true;
+      return;
+    }
     int ww, wh;
     glfwGetWindowSize(m_win, &ww, &wh);
     if (m_nav.move(x, y, ww, wh, shown_camera())) moved_view();
@@ -229,6 +242,31 @@ class Viewer {
 
   void on_wheel(double steps) {
     if (m_nav.scroll(steps)) moved_view();
+  }
+
+  // ---- the course's cell mode: a rubber band picks the cell (-p) the render redoes ----
+
+  void cell_button(bool down, double x, double y) {
+    if (down) return m_band.press(x, y);
+    m_band.move(x, y);
+    m_dirty = true;
+    int ww, wh, cx, cy, cw, ch;
+    glfwGetWindowSize(m_win, &ww, &wh);
+    const RenderParams now = want();
+    if (!m_band.release(ww, wh, now.width, now.height, cx, cy, cw, ch)) return on_click(x, y);  // a click focuses
+    change([=](RenderParams& p) {
+      p.cell_x = cx, p.cell_y = cy, p.cell_w = cw, p.cell_h = ch;
+      return "cell: " + std::to_string(cx) + " " + std::to_string(cy) + " " + std::to_string(cw) + " " + std::to_string(ch);
+    });
+  }
+
+  // Back to the whole frame (leaving cell mode, moving the camera, resizing).
+  void clear_cell() {
+    if (want().cell_w == 0) return;
+    change([](RenderParams& p) {
+      p.cell_x = p.cell_y = p.cell_w = p.cell_h = 0;
+      return std::string("cell: whole frame");
+    });
   }
 
   // The camera the window shows now, at the full window size.
@@ -242,6 +280,7 @@ class Viewer {
   // A new pose: a coarse preview renders at once (the previous one is cancelled).
   void moved_view() {
     m_moved_at = Clock::now();
+    clear_cell();
     change([this](RenderParams& p) {
       m_sh.view = m_nav.pose();
       if (!m_previewing) m_full_w = p.width, m_full_h = p.height;
@@ -258,13 +297,7 @@ class Viewer {
     m_previewing = false;
     change([this](RenderParams& p) {
       p.width = m_full_w, p.height = m_full_h;
-      const ViewPose v = m_sh.view;
-      if (!v.moved) return std::string("camera: initial");
-      char text[200];
-      std::snprintf(text, sizeof text, "camera: position %s %s %s, target %s %s %s", fmt_g(v.position.x).c_str(),
-                    fmt_g(v.position.y).c_str(), fmt_g(v.position.z).c_str(), fmt_g(v.target.x).c_str(),
-                    fmt_g(v.target.y).c_str(), fmt_g(v.target.z).c_str());
-      return std::string(text);
+      return "camera: " + pose_text(m_sh.view);
     });
   }
 
@@ -287,29 +320,24 @@ class Viewer {
     if (now.width != w || now.height != h)
       change([w, h](RenderParams& p) {
         p.width = w, p.height = h;
+        p.cell_x = p.cell_y = p.cell_w = p.cell_h = 0;  // a cell of the old frame
         return "size " + std::to_string(w) + "x" + std::to_string(h);
       });
   }
 
+  // Tiles go into the frame-sized image at the session's cell offset: a cell render paints over
+  // the image the window shows, as the course's does.
   void upload_tiles(const Status& st) {
     if (st.gen != 0 && st.gen != m_tex_gen) {
       m_tex_gen = st.gen;
-      if (st.width != m_tex_w || st.height != m_tex_h) {
-        m_tex_w = st.width;
-        m_tex_h = st.height;
+      m_cell_x0 = st.cell_x0, m_cell_y0 = st.cell_y0;
+      if (st.frame_w != m_tex_w || st.frame_h != m_tex_h) {
+        m_tex_w = st.frame_w;
+        m_tex_h = st.frame_h;
         m_rgb.assign(size_t(m_tex_w) * m_tex_h * 3, 0);
         m_rate.assign(m_rgb.size(), 0);
         m_count.assign(size_t(m_tex_w) * m_tex_h, 0);
-        glBindTexture(GL_TEXTURE_2D, m_tex);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-        glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
-        glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, m_tex_w, m_tex_h, 0, GL_RGB, GL_UNSIGNED_BYTE, m_rgb.data());
+        gl_texture_init(m_tex, m_tex_w, m_tex_h, m_rgb.data());
         m_dirty = true;
       }
     }
@@ -321,64 +349,41 @@ class Viewer {
     for (const TileUpdate& u : tiles) {
       if (u.gen != m_tex_gen) continue;  // from a session that was replaced
       const Tile& t = u.tile;
-      int tw = t.x1 - t.x0;
+      const int tw = t.x1 - t.x0, x0 = t.x0 + m_cell_x0, y0 = t.y0 + m_cell_y0;
+      if (x0 < 0 || y0 < 0 || x0 + tw > m_tex_w || y0 + (t.y1 - t.y0) > m_tex_h) continue;
       for (int y = t.y0; y < t.y1; ++y) {
-        size_t dst = (size_t(y) * m_tex_w + t.x0) * 3, src = size_t(y - t.y0) * tw * 3;
+        size_t dst = (size_t(y + m_cell_y0) * m_tex_w + x0) * 3, src = size_t(y - t.y0) * tw * 3;
         std::copy(u.rgb.begin() + src, u.rgb.begin() + src + tw * 3, m_rgb.begin() + dst);
         std::copy(u.rate.begin() + src, u.rate.begin() + src + tw * 3, m_rate.begin() + dst);
         std::copy(u.count.begin() + src / 3, u.count.begin() + src / 3 + tw, m_count.begin() + dst / 3);
       }
-      upload_rect(t.x0, t.y0, tw, t.y1 - t.y0);
+      upload_rect(x0, y0, tw, t.y1 - t.y0);
     }
   }
 
   void upload_rect(int x, int y, int w, int h) {
     const std::vector<uint8_t>& src = m_show_rate ? m_rate : m_rgb;
     if (src.empty()) return;
-    glBindTexture(GL_TEXTURE_2D, m_tex);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, m_tex_w);
-    glPixelStorei(GL_UNPACK_SKIP_PIXELS, x);
-    glPixelStorei(GL_UNPACK_SKIP_ROWS, y);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, x, y, w, h, GL_RGB, GL_UNSIGNED_BYTE, src.data());
+    gl_texture_update(m_tex, src.data(), m_tex_w, x, y, w, h);
     m_dirty = true;
   }
 
   void upload_all() { upload_rect(0, 0, m_tex_w, m_tex_h); }
 
-  // The image, then the overlay.
+  // The image, the cell mode's band, then the overlay.
   void draw() {
-    int fw, fh;
+    int fw, fh, ww, wh;
     glfwGetFramebufferSize(m_win, &fw, &fh);
-    draw_image(fw, fh);
+    gl_draw_texture(m_tex_w > 0 ? m_tex : 0, fw, fh);
+    if (m_band.active()) {
+      double x0, y0, x1, y1;
+      m_band.corners(x0, y0, x1, y1);
+      glfwGetWindowSize(m_win, &ww, &wh);
+      gl_draw_band(x0, y0, x1, y1, ww, wh);
+    }
     Overlay o = layout_overlay(overlay_inputs(), fw, fh);
     draw_overlay(o, fw, fh);
     m_panel_lines = o.panel_layout.lines;
-  }
-
-  // The texture on a full-window quad; texture row 0 is the image's top row.
-  void draw_image(int fw, int fh) {
-    glViewport(0, 0, fw, fh);
-    glClearColor(0, 0, 0, 1);
-    glClear(GL_COLOR_BUFFER_BIT);
-    if (m_tex_w == 0) return;
-    glMatrixMode(GL_PROJECTION);
-    glLoadIdentity();
-    glMatrixMode(GL_MODELVIEW);
-    glLoadIdentity();
-    glDisable(GL_BLEND);
-    glDisable(GL_DEPTH_TEST);
-    glEnable(GL_TEXTURE_2D);
-    glBindTexture(GL_TEXTURE_2D, m_tex);
-    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_REPLACE);
-    glColor4f(1, 1, 1, 1);
-    glBegin(GL_QUADS);
-    glTexCoord2f(0, 1); glVertex2f(-1, -1);
-    glTexCoord2f(1, 1); glVertex2f(1, -1);
-    glTexCoord2f(1, 0); glVertex2f(1, 1);
-    glTexCoord2f(0, 0); glVertex2f(-1, 1);
-    glEnd();
-    glDisable(GL_TEXTURE_2D);
   }
 
   // What the overlay is drawn over and which of its parts are on.
@@ -494,15 +499,8 @@ class Viewer {
     draw();
     int fw, fh;
     glfwGetFramebufferSize(m_win, &fw, &fh);
-    std::vector<uint8_t> rows(size_t(fw) * fh * 3), top_first(rows.size());
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_BACK);
-    glReadPixels(0, 0, fw, fh, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
-    size_t stride = size_t(fw) * 3;
-    for (int y = 0; y < fh; ++y)
-      std::copy(rows.begin() + (fh - 1 - y) * stride, rows.begin() + (fh - y) * stride, top_first.begin() + y * stride);
     try {
-      write_png8(top_first, fw, fh, path);
+      write_png8(gl_read_frame(fw, fh), fw, fh, path);
       say("screenshot: %s %dx%d", path.c_str(), fw, fh);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "pathtracer: screenshot: %s\n", e.what());
@@ -518,6 +516,7 @@ class Viewer {
   GLuint m_tex = 0;
   int m_tex_w = 0, m_tex_h = 0;
   uint64_t m_tex_gen = 0;
+  int m_cell_x0 = 0, m_cell_y0 = 0;    // where the session's image lies in the texture (a cell's offset)
   std::vector<uint8_t> m_rgb, m_rate;  // what the texture holds, for each view
   std::vector<uint32_t> m_count;       // samples in each pixel, for the rate legend
   bool m_show_rate = false, m_show_keys = false, m_show_panel = true, m_dirty = true;
@@ -525,6 +524,8 @@ class Viewer {
   int m_resize_w = 0, m_resize_h = 0;
   Clock::time_point m_resize_at;
   CameraNav m_nav;
+  bool m_cell_mode = false;  // C: a left drag picks a cell instead of orbiting
+  CellBand m_band;
   SceneFeatures m_features;
   std::set<std::string> m_hinted;
   bool m_previewing = false;  // rendering at 1/kPreviewScale while the camera moves

@@ -1,7 +1,7 @@
 // The GLFW debug window (`pathtracer scene.dae` without -f): the progressive render as it
 // converges, a status panel and rate legend over it, the course's render-mode keys,
-// click-to-focus, and a script player for tests. viewer.cpp, viewer_script.cpp and overlay.cpp
-// are the only files that include GLFW / OpenGL; they are linked into the pathtracer executable
+// click-to-focus, camera moves, cell mode, and a script player for tests. viewer.cpp,
+// viewer_gl.cpp, viewer_script.cpp and overlay.cpp are the only files that include GLFW / OpenGL; they are linked into the pathtracer executable
 // only, never into the renderer library.
 #pragma once
 

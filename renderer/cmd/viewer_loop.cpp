@@ -138,6 +138,10 @@ void RenderLoop::start_session(const RenderParams& p, const ViewPose& view, uint
   m_status.gen = gen;
   m_status.width = m_session->width();
   m_status.height = m_session->height();
+  m_status.frame_w = p.width;
+  m_status.frame_h = p.height;
+  m_status.cell_x0 = p.cell_w > 0 ? p.cell_x : 0;
+  m_status.cell_y0 = p.cell_w > 0 ? p.height - (p.cell_y + p.cell_h) : 0;
   m_status.spp = p.spp;
   std::lock_guard<std::mutex> lk(m_sh.mutex);
   m_sh.status = m_status;

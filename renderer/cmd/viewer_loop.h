@@ -49,7 +49,8 @@ struct TileUpdate {
 // What the render thread reports about the session it runs.
 struct Status {
   uint64_t gen = 0;  // 0: no session yet
-  int width = 0, height = 0;
+  int width = 0, height = 0;  // the session's image: the frame, or its cell (-p, the C key)
+  int frame_w = 0, frame_h = 0, cell_x0 = 0, cell_y0 = 0;  // the frame, and where the image's top-left lies in it
   int spp = 0;           // the session's target
   int reached_spp = 0;   // the last completed pass's target
   bool finished = false;

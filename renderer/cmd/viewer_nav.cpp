@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace pt {
 namespace viewer {
@@ -15,6 +16,17 @@ constexpr float kMinPolar = 1e-3f;                // the poles: the basis needs 
 constexpr float kDollyStep = 1.0f / 20, kMinDistance = 1.0f / 20, kMaxDistance = 10;
 
 }  // namespace
+
+std::string pose_text(const ViewPose& v) {
+  if (!v.moved) return "initial";
+  auto g = [](float x) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", double(x));
+    return std::string(b);
+  };
+  return "position " + g(v.position.x) + " " + g(v.position.y) + " " + g(v.position.z) + ", target " + g(v.target.x) +
+         " " + g(v.target.y) + " " + g(v.target.z);
+}
 
 void CameraNav::reset(const Camera& c) {
   Vec3 d = c.position - c.target;
@@ -83,6 +95,21 @@ void CameraNav::home() {
   m_target = m_target0;
   m_phi = m_phi0, m_theta = m_theta0, m_r = m_r0;
   m_moved = false;
+}
+
+bool CellBand::release(int ww, int wh, int fw, int fh, int& x, int& y, int& dx, int& dy) {
+  m_active = false;
+  if (ww <= 0 || wh <= 0 || fw <= 0 || fh <= 0) return false;
+  // Window to frame pixels (a HiDPI framebuffer has more pixels than the window has points); the
+  // band covers every pixel it touches.
+  const double sx = double(fw) / ww, sy = double(fh) / wh;
+  auto clampi = [](double v, int hi) { return std::min(std::max(int(v), 0), hi); };
+  const int left = clampi(std::floor(std::min(m_x0, m_x1) * sx), fw), right = clampi(std::ceil(std::max(m_x0, m_x1) * sx), fw);
+  const int top = clampi(std::floor(std::min(m_y0, m_y1) * sy), fh), bottom = clampi(std::ceil(std::max(m_y0, m_y1) * sy), fh);
+  if (right - left < 2 || bottom - top < 2) return false;
+  x = left, dx = right - left;
+  y = fh - bottom, dy = bottom - top;  // bottom-left origin, as -p counts
+  return true;
 }
 
 }  // namespace viewer

@@ -7,6 +7,8 @@
 // is a click (autofocus), not a drag. No GLFW here: viewer.cpp feeds it window coordinates.
 #pragma once
 
+#include <string>
+
 #include "camera.h"
 
 namespace pt {
@@ -17,6 +19,9 @@ struct ViewPose {
   bool moved = false;
   Vec3 position, target;
 };
+
+// "position x y z, target x y z" (shortest %g), or "initial" for an unmoved pose.
+std::string pose_text(const ViewPose& pose);
 
 class CameraNav {
  public:
@@ -44,6 +49,25 @@ class CameraNav {
   bool m_pressed = false, m_dragged = false;
   Button m_button = left;
   double m_press_x = 0, m_press_y = 0, m_last_x = 0, m_last_y = 0;
+};
+
+// The course's cell mode (C): a left drag draws a rubber band, and its release picks the cell the
+// render redoes (-p: x y dx dy, bottom-left origin, in frame pixels).
+class CellBand {
+ public:
+  void press(double x, double y) { m_active = true, m_x0 = m_x1 = x, m_y0 = m_y1 = y; }
+  void move(double x, double y) { m_x1 = x, m_y1 = y; }
+  void cancel() { m_active = false; }
+  bool active() const { return m_active; }
+  // The band in window coordinates, as drawn.
+  void corners(double& x0, double& y0, double& x1, double& y1) const { x0 = m_x0, y0 = m_y0, x1 = m_x1, y1 = m_y1; }
+  // Ends the drag: the cell under the band in a fw x fh frame shown in a ww x wh window, clipped
+  // to the frame. False for a band under two frame pixels wide or tall (a click).
+  bool release(int ww, int wh, int fw, int fh, int& x, int& y, int& dx, int& dy);
+
+ private:
+  bool m_active = false;
+  double m_x0 = 0, m_y0 = 0, m_x1 = 0, m_y1 = 0;
 };
 
 }  // namespace viewer
