@@ -31,6 +31,15 @@ function fmtDuration(s) {
   return `${Math.floor(s / 3600)} h ${Math.round((s % 3600) / 60)} min`;
 }
 
+// A point or direction, short: (0.12, 1, -4.5); rounding noise (2.9e-16) reads 0.
+function fmtVec(v) { return `(${(v || []).map((x) => fmtNum(Math.abs(x) < 1e-9 ? 0 : x, 3)).join(', ')})`; }
+
+// A camera ({position, target, up, vfov}) in one line; null is the scene's own framing.
+function fmtCamera(c) {
+  if (!c) return 'the scene\'s own framing';
+  return `from ${fmtVec(c.position)} at ${fmtVec(c.target)}${c.vfov ? `, ${fmtNum(c.vfov, 3)}°` : ''}`;
+}
+
 function shortId(id) { return id.length > 8 ? id.slice(-8) : id; }
 
 function randomKey() {

@@ -235,3 +235,15 @@ function clearCanvas(canvas, w, h) {
   ctx.fillStyle = '#0b0d10';
   ctx.fillRect(0, 0, canvas.width, canvas.height);
 }
+
+// Resizes a canvas to w x h keeping its picture, scaled: what was seen stays until new tiles cover it.
+function resizeKeeping(canvas, w, h) {
+  if (canvas.width === w && canvas.height === h) return;
+  const old = document.createElement('canvas');
+  old.width = canvas.width;
+  old.height = canvas.height;
+  old.getContext('2d').drawImage(canvas, 0, 0);
+  canvas.width = w;
+  canvas.height = h;
+  canvas.getContext('2d').drawImage(old, 0, 0, w, h);
+}

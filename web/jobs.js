@@ -15,6 +15,7 @@ const OTHER_SETTINGS = [
   ['caustic_tracing', (v) => (v ? 'caustics' : 'no caustics')],
   ['frame_scene', (v) => (v ? 'fitted to the scene' : 'course framing')],
   ['keep_fov', (v) => (v ? 'whole course view' : 'course crop')],
+  ['camera', (v) => `camera ${fmtCamera(v)}`],
 ];
 
 // The columns after Job and Created: [class, text of a job, key compared between neighbours or null].
@@ -52,7 +53,7 @@ function fmtCreated(t) {
 // The settings without a column of their own that differ from the API's defaults.
 function otherSettings(spec) {
   const d = state.defaults;
-  const differs = ([name]) => (spec[name] !== undefined && spec[name] !== d[name]) ||
+  const differs = ([name]) => (name === 'camera' ? !!spec.camera : spec[name] !== undefined && spec[name] !== d[name]) ||
     (name === 'adaptive' && spec.adaptive && spec.adaptive_tolerance !== d.adaptive_tolerance);
   return OTHER_SETTINGS.filter(differs).map(([name, label]) => label(spec[name], spec)).join(', ');
 }
@@ -225,7 +226,7 @@ async function refreshJobs() {
     }
     const wasDown = state.pollOk === false;
     state.pollOk = true;
-    renderJobs(jobs);
+    renderJobs(jobs.filter((j) => !nav.previews.has(j.id)));  // a camera move's previews come and go
     if (wasDown) onReconnected();
     updateConn();
     schedulePoll();
@@ -250,7 +251,7 @@ function initJobs() {
     const b = e.target.closest('[data-action]');
     if (!b || b.tagName === 'A' || b.tagName === 'INPUT') return;  // links; compare boxes: compare.js
     const id = b.closest('tr').dataset.id;
-    if (b.dataset.action === 'open') viewer.show(id, { fill: true });
+    if (b.dataset.action === 'open') viewer.show(id);
     else if (b.dataset.action === 'delete') armDelete(b, id);
     else jobAction(id, b.dataset.action);
   });

@@ -13,6 +13,10 @@ async function runSweep(kind) {
   if ($('#sweep-half').checked) {
     base.width = Math.max(8, Math.round((spec.width ?? d.width ?? 480) / 2));
     base.height = Math.max(8, Math.round((spec.height ?? d.height ?? 360) / 2));
+    // A smaller copy of the same view, not the centre of it (what the course crop makes of a
+    // smaller size): the view on screen, else the form's at full size, as the camera field.
+    if (!base.camera) base.camera = await viewOf(spec);
+    if (!base.camera) delete base.camera;
   }
   let values, key, title, sub, note = '';
   if (kind === 'focus') {
@@ -57,6 +61,15 @@ async function runSweep(kind) {
   } finally {
     buttons.forEach((b) => { b.disabled = false; });
   }
+}
+
+// The shown job's view when it is of the form's scene, else the view the form's spec renders from
+// (/api/jobs/check); null when the server reports none.
+async function viewOf(spec) {
+  const st = viewer.feed && !viewer.preview && viewer.feed.status;
+  if (st && st.view && st.spec && st.spec.scene === spec.scene) return st.view;
+  const r = await postJson('/api/jobs/check', spec);
+  return r && r.ok && r.data.view ? r.data.view : null;
 }
 
 class SweepCell {

@@ -27,8 +27,7 @@ async function uploadScene(file) {
   if (!r || !r.ok) return uploadNote(`${file.name}: ${apiError(r).message}`, 'error');
   await loadScenes();
   $('#f-scene').value = name;
-  showSceneSummary();
-  scheduleCheck();
+  onSceneChosen();  // its own lens, as a scene picked from the list
   uploadNote(`Scene '${name}' ${r.status === 201 ? 'uploaded' : 'replaced'}: selected for the next job.`, 'ok');
 }
 

@@ -1,6 +1,7 @@
 // The viewer's tools, as in tev or Blender's image editor: exposure in stops and a display mapping
 // (the course's PNG curve, sRGB, linear) applied to the job's float pixels (GET /pixels), the
-// sample-rate image with its legend, 1:1 zoom with drag to pan, and the pixel under the cursor.
+// sample-rate image with its legend, zoom (the wheel around the cursor, fit to 32x, nearest texels
+// past 1:1; drag to pan), what the mouse does on the image, and the pixel under the cursor.
 'use strict';
 
 // The course's PNG curve (renderer/util/image.cpp, tonemap_course) in float32 steps, so that at
@@ -35,6 +36,17 @@ function rateRgb(count, spp) {
 // needs them, at most every REFETCH_MS: they are 16 bytes a pixel (2.7 MB at 480x360) against the
 // stream's few PNG tiles, and without a tool the tiles already show the course's mapping.
 const REFETCH_MS = 2000;
+const MAX_ZOOM = 32;  // device pixels an image pixel, at most
+
+// A wheel event's travel in pixels, whatever unit the browser gave it in.
+function wheelPixels(e) {
+  return e.deltaY * (e.deltaMode === 1 ? 33 : e.deltaMode === 2 ? 800 : 1);
+}
+
+const MOUSE_HINTS = {
+  camera: 'Drag to orbit · shift- or right-drag to pan · wheel to dolly · click to focus',
+  zoom: 'Wheel to zoom around the cursor (to 32×) · drag to pan the zoomed picture · click to focus',
+};
 
 const tools = {
   data: null,        // {id, w, h, px: Float32Array (r, g, b, count) a pixel, min, max}
@@ -46,7 +58,8 @@ const tools = {
   exposure: 0,
   mapping: 'course',
   rate: false,
-  zoom: 'fit',       // or '1:1'
+  zoom: 'fit',       // 'fit', '1:1' or a magnification (device pixels an image pixel)
+  mouse: 'camera',   // what the mouse does on the image: 'camera' (camera.js) or 'zoom'
   pan: { x: 0, y: 0 },
   drag: null,
   dragged: false,
@@ -55,16 +68,21 @@ const tools = {
   active() { return this.exposure !== 0 || this.mapping !== 'course' || this.rate; },
 
   reset() {
+    this.resetData();
+    this.pan = { x: 0, y: 0 };
+    this.applyZoom();
+  },
+
+  // Another job's picture, seen through the same zoom (a camera move's preview).
+  resetData() {
     this.data = null;
     this.missing = null;
     this.stale = true;
     clearTimeout(this.timer);
     this.timer = null;
-    this.pan = { x: 0, y: 0 };
     $('#v-readout').textContent = '';
     $('#v-tools').dataset.data = 'none';
     this.showLegend();
-    this.applyZoom();
   },
 
   // The job's picture changed (new tiles); with `ended`, it will not change again.
@@ -176,17 +194,31 @@ const tools = {
 
   // ---------- zoom and pan ----------
 
+  // Device pixels an image pixel, now.
+  magnification() {
+    if (this.zoom === '1:1') return 1;
+    if (this.zoom !== 'fit') return this.zoom;
+    return ($('#v-wrap').clientWidth / $('#v-canvas').width) * (window.devicePixelRatio || 1);
+  },
+
   applyZoom() {
     const canvas = $('#v-canvas'), wrap = $('#v-wrap');
-    wrap.dataset.zoom = this.zoom;
-    $('#v-zoom-fit').setAttribute('aria-pressed', String(this.zoom === 'fit'));
+    const fit = this.zoom === 'fit';
+    const dpr = window.devicePixelRatio || 1;
+    const m = this.magnification();
+    wrap.dataset.zoom = fit ? 'fit' : this.zoom === '1:1' ? '1:1' : 'zoomed';
+    wrap.dataset.scale = String(Number(m.toFixed(4)));
+    $('#v-zoom-fit').setAttribute('aria-pressed', String(fit));
     $('#v-zoom-1').setAttribute('aria-pressed', String(this.zoom === '1:1'));
-    if (this.zoom === 'fit') {
+    $('#v-zoom-level').textContent = `${fmtNum(m, 3)}×`;
+    // Texels as squares once zoomed past 1:1; when fitted, only from 2x (a blur reads better below).
+    canvas.style.imageRendering = (fit ? m / dpr >= 2 : m > 1.0001) ? 'pixelated' : 'auto';
+    this.showMouse();
+    if (fit) {
       canvas.style.width = canvas.style.height = canvas.style.left = canvas.style.top = '';
       return;
     }
-    const dpr = window.devicePixelRatio || 1;
-    const w = canvas.width / dpr, h = canvas.height / dpr;
+    const w = (canvas.width * m) / dpr, h = (canvas.height * m) / dpr;
     // Centred, then panned; a quarter of the picture always stays in view.
     const maxX = Math.max(0, (w - wrap.clientWidth) / 2) + wrap.clientWidth / 4;
     const maxY = Math.max(0, (h - wrap.clientHeight) / 2) + wrap.clientHeight / 4;
@@ -206,6 +238,55 @@ const tools = {
     this.pan = { x: 0, y: 0 };
     $('#v-marker').hidden = true;
     this.applyZoom();
+  },
+
+  // Zooms by `factor` keeping the image point under (cx, cy) (client pixels) where it is.
+  zoomAt(factor, cx, cy) {
+    const canvas = $('#v-canvas'), wrap = $('#v-wrap');
+    const dpr = window.devicePixelRatio || 1;
+    const fitM = (wrap.clientWidth / canvas.width) * dpr;
+    const m = Math.min(Math.max(MAX_ZOOM, fitM), this.magnification() * factor);
+    $('#v-marker').hidden = true;
+    if (m <= fitM * 1.0001) {
+      this.setZoom('fit');
+      return;
+    }
+    const r = canvas.getBoundingClientRect(), wr = wrap.getBoundingClientRect();
+    const u = ((cx - r.left) / r.width) * canvas.width, v = ((cy - r.top) / r.height) * canvas.height;
+    const s = m / dpr;
+    this.zoom = Math.abs(m - 1) < 1e-4 ? '1:1' : m;
+    this.pan = {
+      x: cx - wr.left - u * s - (wrap.clientWidth - canvas.width * s) / 2,
+      y: cy - wr.top - v * s - (wrap.clientHeight - canvas.height * s) / 2,
+    };
+    this.applyZoom();
+  },
+
+  // The picture changed size (a camera move's smaller preview): it keeps its size on screen.
+  onResize(oldWidth, newWidth) {
+    if (typeof this.zoom === 'number' && oldWidth > 0 && newWidth > 0 && oldWidth !== newWidth)
+      this.zoom *= oldWidth / newWidth;
+  },
+
+  // ---------- what the mouse does ----------
+
+  // 'camera' where the shown job's view is known (camera.js), else 'zoom'.
+  mouseMode() { return this.mouse === 'camera' && nav.available() ? 'camera' : 'zoom'; },
+
+  setMouse(mode) {
+    this.mouse = mode;
+    this.showMouse();
+  },
+
+  showMouse() {
+    const mode = this.mouseMode();
+    $('#v-wrap').dataset.mouse = mode;
+    const cam = $('#v-mouse-camera');
+    cam.setAttribute('aria-pressed', String(mode === 'camera'));
+    cam.disabled = !nav.available();
+    cam.title = cam.disabled ? 'Open a job whose view the server reports to move its camera' : MOUSE_HINTS.camera;
+    $('#v-mouse-zoom').setAttribute('aria-pressed', String(mode === 'zoom'));
+    $('#v-mouse-hint').textContent = MOUSE_HINTS[mode];
   },
 
   // ---------- the pixel under the cursor ----------
@@ -252,19 +333,31 @@ function initViewerTools() {
   $('#v-mapping').addEventListener('change', (e) => { tools.mapping = e.target.value; tools.changed(); });
   $('#v-rate').addEventListener('change', (e) => { tools.rate = e.target.checked; tools.changed(); });
   $('#v-zoom-fit').addEventListener('click', () => tools.setZoom('fit'));
-  $('#v-zoom-1').addEventListener('click', () => tools.setZoom('1:1'));
+  // 1:1 is for looking at pixels: the mouse zooms and pans the picture from then on.
+  $('#v-zoom-1').addEventListener('click', () => { tools.setMouse('zoom'); tools.setZoom('1:1'); });
+  $('#v-mouse-camera').addEventListener('click', () => tools.setMouse('camera'));
+  $('#v-mouse-zoom').addEventListener('click', () => tools.setMouse('zoom'));
 
   const wrap = $('#v-wrap');
+  wrap.addEventListener('wheel', (e) => {
+    if (!viewer.id) return;  // nothing shown: the page scrolls
+    e.preventDefault();
+    if (tools.mouseMode() === 'camera') nav.wheel(e);
+    else tools.zoomAt(2 ** (-wheelPixels(e) / 200), e.clientX, e.clientY);
+  }, { passive: false });
   wrap.addEventListener('pointerdown', (e) => {
     tools.dragged = false;
-    if (tools.zoom !== '1:1' || e.button !== 0) return;
+    if (tools.zoom === 'fit' || tools.mouseMode() !== 'zoom' || e.button !== 0) return;
     tools.drag = { x: e.clientX, y: e.clientY, pan: { ...tools.pan } };
-    wrap.setPointerCapture(e.pointerId);
   });
   wrap.addEventListener('pointermove', (e) => {
     if (tools.drag) {
       const dx = e.clientX - tools.drag.x, dy = e.clientY - tools.drag.y;
-      if (Math.abs(dx) + Math.abs(dy) > 3) tools.dragged = true;
+      // Captured once it is a drag: a click stays a click on the canvas (focus there).
+      if (Math.abs(dx) + Math.abs(dy) > 3 && !tools.dragged) {
+        tools.dragged = true;
+        wrap.setPointerCapture(e.pointerId);
+      }
       tools.pan = { x: tools.drag.pan.x + dx, y: tools.drag.pan.y + dy };
       $('#v-marker').hidden = true;
       tools.applyZoom();

@@ -77,14 +77,14 @@ test('the page lists the scenes and fills the form with the API defaults', async
   assert.match(await page.textContent('#scene-summary'), /triangles/);
 });
 
-test('a bad value is explained next to its field', async () => {
+test('a bad value is explained next to its field, in the words of its label', async () => {
   await fill({ spp: 0 });
-  await page.waitForFunction(() => /spp.*between 1 and/.test(document.querySelector('#err-spp').textContent));
+  await page.waitForFunction(() => /^Samples per pixel must be between 1 and \d+$/.test(document.querySelector('#err-spp').textContent));
   assert.equal(await page.getAttribute('#f-spp', 'aria-invalid'), 'true');
   await fill({ spp: 8 });
   await page.waitForFunction(() => document.querySelector('#err-spp').textContent === '');
   await fill({ width: 100000 });
-  await page.waitForFunction(() => /width.*4096/.test(document.querySelector('#err-width').textContent));
+  await page.waitForFunction(() => /^Width must be at most 4096/.test(document.querySelector('#err-width').textContent));
   // Submitting anyway creates nothing and keeps the explanation beside the field.
   await page.click('#submit');
   await page.waitForTimeout(300);
@@ -99,10 +99,13 @@ test('a bad value is explained next to its field', async () => {
 // marks each field named, whichever shape the answer has.
 test('every invalid field an error answer lists is marked at once', async () => {
   const answers = [
-    { status: 400, message: 'spp must be at least 1', field: 'spp',
-      errors: [{ field: 'spp', message: 'spp must be at least 1' }, { field: 'width', message: 'width must be at most 4096' }] },
+    { status: 400, message: "'spp' must be at least 1", field: 'spp',
+      errors: [{ field: 'spp', message: "'spp' must be at least 1" }, { field: 'width', message: 'width x height x spp is too many' }] },
     { status: 400, message: 'height must be at least 1', field: 'height' },
   ];
+  // The page speaks of each field by its label.
+  const spoken = { "'spp' must be at least 1": 'Samples per pixel must be at least 1',
+    'width x height x spp is too many': 'Width x height x samples per pixel is too many', 'height must be at least 1': 'Height must be at least 1' };
   for (const error of answers) {
     await page.route('**/api/jobs/check', (route) =>
       route.fulfill({ status: 400, contentType: 'application/json', body: JSON.stringify({ error }) }));
@@ -110,7 +113,7 @@ test('every invalid field an error answer lists is marked at once', async () => 
     const listed = error.errors || [error];
     await page.waitForFunction((fields) => fields.every((f) => document.querySelector(`#f-${f}`).getAttribute('aria-invalid') === 'true'),
       listed.map((e) => e.field));
-    for (const e of listed) assert.equal(await page.textContent(`#err-${e.field}`), e.message);
+    for (const e of listed) assert.equal(await page.textContent(`#err-${e.field}`), spoken[e.message]);
     assert.equal(await page.$$eval('#job-form [aria-invalid="true"]', (els) => els.length), listed.length);
     await page.unroute('**/api/jobs/check');
   }

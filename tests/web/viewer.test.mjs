@@ -1,7 +1,7 @@
 // The viewer's tools and the comparison of two jobs, in a real browser against a real
 // render-server (harness.mjs): exposure and display mappings on the float pixels (GET /pixels),
-// the pixel readout, the sample-rate view, 1:1 zoom and pan, the framing choice, and A/B compare
-// side by side and as a wipe. Pictures are checked by pixel statistics; every wait is on a state
+// the pixel readout, the sample-rate view, 1:1 zoom and pan, wheel zoom to 32x with square texels,
+// the framing choice, and A/B compare side by side, as a wipe and as a false-colour difference. Pictures are checked by pixel statistics; every wait is on a state
 // the page shows.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -81,8 +81,9 @@ async function blackShare(selector) {
   return black / (rgba.length / 4);
 }
 
-test('the scene-fitted framing (the default) fills the image; the course crop and whole view leave black', async () => {
-  assert.equal(await page.inputValue('#f-framing'), 'scene');
+test('the scene-fitted framing fills the image; the course crop (the default, as the API\'s) and whole view leave black', async () => {
+  assert.equal(await page.inputValue('#f-framing'), 'crop');
+  assert.equal((await api.json('/api/scenes')).defaults.frame_scene, false);
   const share = {};
   for (const framing of ['scene', 'crop', 'whole']) {
     await page.selectOption('#f-framing', framing);
@@ -96,7 +97,7 @@ test('the scene-fitted framing (the default) fills the image; the course crop an
     await page.locator('#v-wrap').screenshot({ path: path.join(artifacts, `web-viewer-framing-${framing}.png`) });
   }
   assert.ok(share.scene < share.crop / 2 && share.scene < share.whole / 2, `near-black shares: ${JSON.stringify(share)}`);
-  await page.selectOption('#f-framing', 'scene');
+  await page.selectOption('#f-framing', 'crop');
 });
 
 test('exposure doubles linear values per stop', async () => {
@@ -232,6 +233,69 @@ test('1:1 shows an image pixel a device pixel, and dragging pans it', async () =
   assert.ok(Math.abs(back.width - fit.width) < 1, `fit again: ${back.width} px`);
 });
 
+test('the wheel zooms around the cursor from fit to 32x, texels drawn as squares past 1:1', async () => {
+  await page.click('#v-mouse-zoom');  // the wheel zooms (with "Move camera" it dollies)
+  await page.waitForSelector('#v-wrap[data-mouse="zoom"]');
+  assert.match(await page.textContent('#v-mouse-hint'), /Wheel to zoom/);
+  await page.locator('#v-wrap').scrollIntoViewIfNeeded();
+  const fit = await page.locator('#v-canvas').boundingBox();
+  const cursor = { x: fit.x + fit.width * 0.3, y: fit.y + fit.height * 0.4 };
+  const under = { u: 0.3 * 96, v: 0.4 * 72 };  // the image point under the cursor
+  await page.mouse.move(cursor.x, cursor.y);
+  let scale = Number(await page.getAttribute('#v-wrap', 'data-scale'));
+  for (let i = 0; i < 30 && scale < 32; ++i) {
+    await page.mouse.wheel(0, -100);
+    await page.waitForFunction((s) => Number(document.querySelector('#v-wrap').dataset.scale) > s, scale);
+    scale = Number(await page.getAttribute('#v-wrap', 'data-scale'));
+  }
+  const dpr = await page.evaluate(() => window.devicePixelRatio);
+  assert.equal(scale, 32);
+  await page.mouse.wheel(0, -100);  // no further than 32x
+  await page.waitForTimeout(200);
+  assert.equal(Number(await page.getAttribute('#v-wrap', 'data-scale')), 32);
+  const box = await page.locator('#v-canvas').boundingBox();
+  assert.ok(Math.abs(box.width * dpr - 96 * 32) < 1, `the picture is ${box.width} px wide at 32x`);
+  // The point under the cursor stayed under it.
+  const u = ((cursor.x - box.x) / box.width) * 96, v = ((cursor.y - box.y) / box.height) * 72;
+  assert.ok(Math.abs(u - under.u) < 0.2 && Math.abs(v - under.v) < 0.2, `(${u}, ${v}) under the cursor, not (${under.u}, ${under.v})`);
+  assert.equal(await page.$eval('#v-canvas', (c) => getComputedStyle(c).imageRendering), 'pixelated');
+  // Nearest texels: every 32x32 block on screen is one flat colour, the canvas pixel's.
+  const tx = Math.floor(under.u) - 1, ty = Math.floor(under.v) - 1, n = 3, side = 32 / dpr;
+  const clip = { x: box.x + tx * side, y: box.y + ty * side, width: n * side, height: n * side };
+  const shot = await page.screenshot({ clip });
+  const seen = await page.evaluate(async (b64) => {
+    const bytes = Uint8Array.from(atob(b64), (ch) => ch.charCodeAt(0));
+    const bmp = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
+    const off = new OffscreenCanvas(bmp.width, bmp.height);
+    off.getContext('2d').drawImage(bmp, 0, 0);
+    return { w: bmp.width, rgba: Array.from(off.getContext('2d').getImageData(0, 0, bmp.width, bmp.height).data) };
+  }, shot.toString('base64'));
+  const { rgba } = await canvasPixels('#v-canvas');
+  let spread = 0, off = 0, edges = 0;
+  for (let by = 0; by < n; ++by)
+    for (let bx = 0; bx < n; ++bx) {
+      const at = (x, y) => 4 * (y * seen.w + x);
+      const c = at(bx * 32 + 16, by * 32 + 16), t = 4 * ((ty + by) * 96 + tx + bx);
+      for (let k = 0; k < 3; ++k) off = Math.max(off, Math.abs(seen.rgba[c + k] - rgba[t + k]));
+      for (let y = by * 32 + 1; y < by * 32 + 31; ++y)
+        for (let x = bx * 32 + 1; x < bx * 32 + 31; ++x)
+          for (let k = 0; k < 3; ++k) spread = Math.max(spread, Math.abs(seen.rgba[at(x, y) + k] - seen.rgba[c + k]));
+      if (bx > 0) for (let k = 0; k < 3; ++k) edges += Math.abs(seen.rgba[at(bx * 32, by * 32 + 16) + k] - seen.rgba[at(bx * 32 - 1, by * 32 + 16) + k]);
+    }
+  assert.ok(spread <= 2, `a texel's block varies by ${spread} levels: smoothed, not nearest`);
+  assert.ok(off <= 3, `a block is ${off} levels off its canvas pixel`);
+  assert.ok(edges > 0, 'the blocks around the cursor are all one colour: nothing was checked');
+  await page.screenshot({ path: path.join(artifacts, 'web-viewer-zoom32.png') });
+  // Zooming out stops at fit.
+  for (let i = 0; i < 30 && (await page.getAttribute('#v-wrap', 'data-zoom')) !== 'fit'; ++i) {
+    await page.mouse.wheel(0, 100);
+    await page.waitForTimeout(50);
+  }
+  await page.waitForSelector('#v-wrap[data-zoom="fit"]');
+  const back = await page.locator('#v-canvas').boundingBox();
+  assert.ok(Math.abs(back.width - fit.width) < 1, `fit again: ${back.width} px`);
+});
+
 test('two jobs compare side by side and by wipe, with their differing settings listed', async () => {
   jobB = await showJob({ scene: 'cornell', width: 96, height: 72, spp: 16, max_depth: 1, aperture: 0.05 });
   await page.check(`#job-rows tr[data-id="${jobA}"] input[data-action="compare"]`);
@@ -256,6 +320,47 @@ test('two jobs compare side by side and by wipe, with their differing settings l
   await setRange('#compare-wipe', 50);
   await page.waitForSelector('#compare-stage[data-wipe="50"]');
   await page.locator('#compare').screenshot({ path: path.join(artifacts, 'web-viewer-compare.png') });
+});
+
+// The share of a canvas's pixels that are not `rgb` (to 2 levels).
+async function shareNot(selector, rgb) {
+  const { rgba } = await canvasPixels(selector);
+  let n = 0;
+  for (let i = 0; i < rgba.length; i += 4) n += [0, 1, 2].some((k) => Math.abs(rgba[i + k] - rgb[k]) > 2);
+  return n / (rgba.length / 4);
+}
+
+test('the difference view shows the error in false colour: none for identical jobs, plenty for different ones', async () => {
+  const zero = [68, 1, 84];  // the false colour of no error (viridis at 0)
+  await page.check('input[name="compare-mode"][value="diff"]');
+  await page.waitForSelector('#compare-metric-box:not([hidden])');
+  await page.waitForSelector('#compare-stage[data-diff="abs"]');
+  assert.ok(await page.isVisible('#compare-diff-canvas'));
+  assert.ok(await page.isVisible('#compare-diff-ramp'));
+  assert.deepEqual(await page.$eval('#compare-diff-canvas', (c) => [c.width, c.height]), [96, 72]);
+  const absShare = await shareNot('#compare-diff-canvas', zero);
+  assert.ok(absShare > 0.3, `only ${absShare} of the pixels show an error between depth 5 and depth 1`);
+  assert.match(await page.textContent('#compare-diff-stats'), /^absolute error: mean \d/);
+  const absPixels = (await canvasPixels('#compare-diff-canvas')).rgba;
+  await page.selectOption('#compare-metric', 'rel');
+  await page.waitForSelector('#compare-stage[data-diff="rel"]');
+  assert.match(await page.textContent('#compare-diff-stats'), /^relative error/);
+  assert.ok(meanAbsDiff(absPixels, (await canvasPixels('#compare-diff-canvas')).rgba) > 1, 'relative error looks like absolute');
+  await page.locator('#compare').screenshot({ path: path.join(artifacts, 'web-viewer-diff.png') });
+  await page.selectOption('#compare-metric', 'abs');
+  // The same settings again: the same pixels (deterministic sampling), no error anywhere.
+  const jobC = await showJob({ scene: 'cornell', width: 96, height: 72, spp: 16, max_depth: 5 });
+  await page.uncheck(`#job-rows tr[data-id="${jobB}"] input[data-action="compare"]`);
+  await page.check(`#job-rows tr[data-id="${jobC}"] input[data-action="compare"]`);
+  await page.waitForFunction((id) => document.querySelector('#compare-b-label').textContent.endsWith(id), jobC.slice(-8));
+  assert.match(await page.textContent('#compare-a-label'), new RegExp(`${jobA.slice(-8)}$`));
+  await page.waitForSelector('#compare-stage[data-diff="abs"]');
+  await page.waitForFunction(() => /largest 0$/.test(document.querySelector('#compare-diff-stats').textContent));
+  assert.equal(await shareNot('#compare-diff-canvas', zero), 0);
+  // Back to A and B, side by side, for the tests after.
+  await page.uncheck(`#job-rows tr[data-id="${jobC}"] input[data-action="compare"]`);
+  await page.check(`#job-rows tr[data-id="${jobB}"] input[data-action="compare"]`);
+  await page.check('input[name="compare-mode"][value="side"]');
 });
 
 test('a finished job without float pixels says so once, and is not asked again', async () => {
