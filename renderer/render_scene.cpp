@@ -300,6 +300,7 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
                  "(--no-default-light: none)\n", base.source.c_str());
     Light env;
     env.kind = LightKind::ambient;
+    rs->default_light = true;
     env.name = "default environment";
     env.color = Vec3(kDefaultEnvironment);
     env.sphere = true;

@@ -88,6 +88,7 @@ struct RenderScene {
   Camera camera;
   SceneFeatures features;
   size_t triangle_count = 0, sphere_count = 0;
+  bool default_light = false;  // lit by the default environment and sun (no lights of its own)
   // What the caustic light tracer samples: delta geometry to aim at, area and mesh lights by power.
   std::vector<CausticTarget> caustic_targets;
   std::vector<Bounds3> object_bounds;  // from SceneBase: what the background mask projects

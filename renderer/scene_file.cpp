@@ -1,11 +1,18 @@
 // The scene entry point: pick the loader by content and name, read files with the size limit.
 #include "scene_file.h"
 
+#include <dirent.h>
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 
 #include "collada.h"
 #include "gltf.h"
+#include "nearest.h"
 
 namespace pt {
 
@@ -74,9 +81,63 @@ SceneFormat detect_scene_format(const std::string& bytes, const std::string& nam
   return i < bytes.size() && bytes[i] == '{' ? SceneFormat::gltf : SceneFormat::collada;
 }
 
+namespace {
+
+// The scene files in `dir` (by extension), sorted.
+std::vector<std::string> scene_files_in(const std::string& dir) {
+  std::vector<std::string> names;
+  DIR* d = opendir(dir.empty() ? "." : dir.c_str());
+  if (!d) return names;
+  for (int n = 0; n < 100000; ++n) {  // a huge folder is not worth a suggestion
+    const dirent* e = readdir(d);
+    if (!e) break;
+    const std::string f = e->d_name;
+    for (const char* ext : kSceneExtensions)
+      if (has_extension(f, ext)) names.push_back(f);
+  }
+  closedir(d);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// Why `path` cannot be opened, in a newcomer's terms: a folder, or a missing file with the
+// nearest scene file's name in its folder (CBsphere.dae: "did you mean CBspheres.dae?").
+std::string cannot_open(const std::string& path) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    const std::vector<std::string> inside = scene_files_in(path);
+    std::string text = path + ": is a folder, not a scene file";
+    if (!inside.empty()) {
+      text += " (it holds " + inside[0];
+      for (size_t i = 1; i < inside.size() && i < 4; ++i) text += ", " + inside[i];
+      text += inside.size() > 4 ? ", ...)" : ")";
+    }
+    return text;
+  }
+  const int err = errno;
+  const size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash);
+  const std::string file = slash == std::string::npos ? path : path.substr(slash + 1);
+  std::string text = path + ": cannot open file";
+  if (err == ENOENT) {
+    text += " (no such file";
+    const std::string near = nearest_name(file, scene_files_in(dir));
+    if (!near.empty()) text += "; did you mean " + (dir.empty() ? near : dir + "/" + near) + "?";
+    text += ")";
+  } else if (err != 0) {
+    text += std::string(" (") + std::strerror(err) + ")";
+  }
+  return text;
+}
+
+}  // namespace
+
 std::string read_scene_bytes(const std::string& path, const LoadLimits& limits) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw SceneError(cannot_open(path));  // opens, reads nothing
+  errno = 0;
   std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw SceneError(path + ": cannot open file");
+  if (!in) throw SceneError(cannot_open(path));
   std::streamoff size = in.tellg();
   if (size < 0) throw SceneError(path + ": cannot read file");
   if (size_t(size) > limits.max_file_bytes)

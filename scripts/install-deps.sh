@@ -1,17 +1,26 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages the project builds and tests with (skips apt when all are present).
+# Installs the Debian 12 packages the project builds and tests with (skips apt when all are present);
+# `install-deps.sh main`: only what building and running the service needs.
 set -euo pipefail
+# What building and running the service needs (scripts/main.sh installs only these: `main`) ...
 packages=(
   build-essential cmake ninja-build pkg-config python3
   libembree-dev libopenimageio-dev openimageio-tools libpugixml-dev libtbb-dev
   libtinygltf-dev  # glTF 2.0 scenes (header-only tinygltf; its images are decoded by OpenImageIO)
-  libgtest-dev libcpp-httplib-dev nlohmann-json3-dev libglfw3-dev xvfb
-  libgl1-mesa-dri xauth  # the window tests: Mesa's llvmpipe OpenGL under Xvfb
-  chromium nodejs npm  # the web page's browser test (tests/web: playwright-core drives this Chromium)
-  python3-venv python3-pip  # build/venv for the server tests (scripts/python-env.sh)
-  redis-server libhiredis-dev  # the scale-out queue (render-worker) and its tests
-  clang libclang-rt-14-dev  # build-fuzz: libFuzzer and the sanitizer runtimes (scripts/fuzz.sh, asan.sh)
+  libgtest-dev libcpp-httplib-dev nlohmann-json3-dev libglfw3-dev
+  libgl1-mesa-dri  # the window's OpenGL without a GPU (Mesa's llvmpipe)
+  libhiredis-dev  # render-worker's Redis client (the scale-out queue)
 )
+# ... and what the tests add.
+if [ "${1:-all}" != main ]; then
+  packages+=(
+    xvfb xauth  # the window tests run under Xvfb
+    chromium nodejs npm  # the web page's browser test (tests/web: playwright-core drives this Chromium)
+    python3-venv python3-pip  # build/venv for the server tests (scripts/python-env.sh)
+    redis-server  # the scale-out tests' Redis
+    clang libclang-rt-14-dev  # build-fuzz: libFuzzer and the sanitizer runtimes (scripts/fuzz.sh, asan.sh)
+  )
+fi
 missing=()
 for p in "${packages[@]}"; do
   # A nodejs that bundles npm (NodeSource's) conflicts with Debian's npm package: keep it.

@@ -3,6 +3,6 @@
 # scenes and the web page. Options are passed to render-server (e.g. --port 9000).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-bash scripts/build.sh
+bash scripts/install-deps.sh main
+bash scripts/build.sh render-server render-worker pathtracer heavy_scene  # not the tests: scripts/test.sh builds those
 exec ./build/render-server --data "${PT_DATA_DIR:-data}" "$@"

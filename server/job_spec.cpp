@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <set>
 
+#include "nearest.h"
+
 namespace srv {
 
 namespace {
@@ -86,7 +88,7 @@ pt::CameraPose parse_camera(const json& cam) {
     throw JobError(JobErrorKind::invalid, "'camera' must be an object {position, target, up, vfov}", "camera");
   for (auto it = cam.begin(); it != cam.end(); ++it)
     if (it.key() != "position" && it.key() != "target" && it.key() != "up" && it.key() != "vfov")
-      throw JobError(JobErrorKind::invalid, "unknown field 'camera." + it.key() + "' (position, target, up, vfov)",
+      throw JobError(JobErrorKind::invalid, "unknown field 'camera." + it.key() + "' (camera fields: position, target, up, vfov)",
                      "camera." + it.key());
   pt::CameraPose pose;
   pose.set = true;
@@ -192,7 +194,12 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   s.time_limit = run.time_limit;
   s.target_error = run.target_error;
   for (auto it = body.begin(); it != body.end(); ++it)
-    if (!r.seen.count(it.key())) errors.emplace_back(it.key(), "unknown field '" + it.key() + "'");
+    if (!r.seen.count(it.key())) {
+      std::vector<std::string> fields{"scene", "camera"};
+      for (const pt::RenderOption& o : pt::render_options()) fields.push_back(o.name);
+      const std::string near = pt::nearest_name(it.key(), fields);
+      errors.emplace_back(it.key(), "unknown field '" + it.key() + "'" + (near.empty() ? "" : " (did you mean '" + near + "'?)"));
+    }
   if (!errors.empty()) throw JobError(JobErrorKind::invalid, std::move(errors));
   double pixel_samples = double(p.width) * p.height * p.spp;
   if (pixel_samples > lim.max_pixel_samples) {

@@ -13,6 +13,7 @@
 #include "connection.h"
 #include "image.h"
 #include "jobs.h"
+#include "nearest.h"
 #include "routes.h"
 #include "version.h"
 
@@ -28,7 +29,9 @@ const char* kUsage =
     "                    proxy's name); repeatable. Other names get 421 (DNS-rebinding defence)\n"
     "  --port N          port (default 8080; 0 picks a free one and prints it)\n"
     "  --data DIR        jobs and images (default ./data)\n"
-    "  --scenes DIR      a folder of .dae scenes; repeatable (default: the bundled scenes/)\n"
+    "  --scenes DIR      a folder of scenes (.dae, .gltf, .glb) served besides the bundled scenes/;\n"
+    "                    repeatable; a name in DIR hides a bundled scene of the same name\n"
+    "  --no-bundled-scenes  serve only the --scenes folders\n"
     "  --web DIR         the page to serve at / (default: the bundled web/)\n"
     "  --threads N       render threads per job (default: all cores)\n"
     "  --concurrency N   jobs rendering at once (default 1)\n"
@@ -123,7 +126,7 @@ int main(int argc, char** argv) {
   long port = 8080, n;
   srv::ManagerConfig cfg;
   cfg.threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  bool scenes_given = false;
+  bool bundled_scenes = true;
   std::vector<std::string> allowed_hosts;
   srv::ApiOptions api;
   api.openapi = kOpenApiJson;
@@ -145,7 +148,8 @@ int main(int argc, char** argv) {
     else if (a == "--allowed-host") allowed_hosts.push_back(value());
     else if (a == "--port") { const char* v = value(); if (!parse_int(v, 0, 65535, &port)) bad(v); }
     else if (a == "--data") cfg.data_dir = value();
-    else if (a == "--scenes") { cfg.scene_dirs.push_back(value()); scenes_given = true; }
+    else if (a == "--scenes") cfg.scene_dirs.push_back(value());
+    else if (a == "--no-bundled-scenes") bundled_scenes = false;
     else if (a == "--web") web = value();
     else if (a == "--threads") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.threads = int(n); }
     else if (a == "--concurrency") { const char* v = value(); if (!parse_int(v, 1, 64, &n)) bad(v); cfg.concurrency = int(n); }
@@ -168,9 +172,19 @@ int main(int argc, char** argv) {
     else if (a == "--read-timeout") { const char* v = value(); if (!parse_seconds(v, &api.limits.request_timeout)) bad(v); }
     else if (a == "-h" || a == "--help") { std::printf("%s", kUsage); return 0; }
     else if (a == "--version") { std::printf("%s\n", pt::version_text("render-server").c_str()); return 0; }
-    else { std::fprintf(stderr, "render-server: unknown option '%s' (see --help)\n", a.c_str()); return 2; }
+    else {
+      std::vector<std::string> flags;  // every flag --help names
+      for (const char* at = kUsage; (at = std::strstr(at, "  --")) != nullptr; at += 2)
+        flags.emplace_back(at + 2, std::strcspn(at + 2, " \n"));
+      flags.emplace_back("-h");
+      const std::string near = pt::nearest_name(a, flags);
+      std::fprintf(stderr, "render-server: unknown option '%s'%s (see --help)\n", a.c_str(),
+                   near.empty() ? "" : (" (did you mean " + near + "?)").c_str());
+      return 2;
+    }
   }
-  if (!scenes_given) cfg.scene_dirs = {PT_SOURCE_DIR "/scenes", PT_BINARY_DIR "/scenes"};
+  if (bundled_scenes)  // after the user's folders: theirs win a name both hold
+    cfg.scene_dirs.insert(cfg.scene_dirs.end(), {PT_SOURCE_DIR "/scenes", PT_BINARY_DIR "/scenes"});
 
   // SIGINT/SIGTERM are taken by one thread with sigwait, so a signal never interrupts a render.
   sigset_t signals;

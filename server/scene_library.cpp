@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "camera.h"
+#include "nearest.h"
 #include "scene_file.h"
 
 namespace srv {
@@ -73,7 +74,7 @@ std::string SceneLibrary::file_name(const std::string& name) const {
 
 std::string SceneLibrary::read_scene(const std::string& name, uint64_t* hash) const {
   std::string path = resolve(name);
-  if (path.empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "scene");
+  if (path.empty()) throw unknown(name, "scene");
   // Checked before reading: the whole file is held in memory while it parses.
   struct stat st;
   if (stat(path.c_str(), &st) == 0 && size_t(st.st_size) > pt::LoadLimits().max_file_bytes)
@@ -185,7 +186,7 @@ std::shared_ptr<const pt::SceneBase> SceneLibrary::load(const std::string& name)
   return base;
 }
 
-json SceneLibrary::list() {
+std::vector<std::string> SceneLibrary::names() const {
   std::set<std::string> names;
   std::vector<std::string> dirs = m_dirs;
   if (!m_upload_dir.empty()) dirs.push_back(m_upload_dir);
@@ -202,14 +203,26 @@ json SceneLibrary::list() {
     }
     closedir(d);
   }
-  json out = json::array();
+  std::vector<std::string> out;
   for (const std::string& name : names)
-    if (!resolve(name).empty()) out.push_back(entry(name));  // a link out of the folder is no scene
+    if (!resolve(name).empty()) out.push_back(name);  // a link out of the folder is no scene
+  return out;
+}
+
+JobError SceneLibrary::unknown(const std::string& name, const char* field) const {
+  const std::string near = pt::nearest_name(name, names());
+  return JobError(JobErrorKind::not_found,
+                  "unknown scene '" + name + "'" + (near.empty() ? "" : " (did you mean '" + near + "'?)"), field);
+}
+
+json SceneLibrary::list() {
+  json out = json::array();
+  for (const std::string& name : names()) out.push_back(entry(name));
   return out;
 }
 
 json SceneLibrary::entry(const std::string& name) {
-  if (resolve(name).empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "name");
+  if (resolve(name).empty()) throw unknown(name, "name");
   json item{{"name", name}, {"source", is_uploaded(name) ? "uploaded" : "bundled"}};
   FileSummary cached = file_summary(name);
   if (!cached.error.empty()) {
@@ -250,7 +263,7 @@ SceneLibrary::FileSummary SceneLibrary::file_summary(const std::string& name) {
 }
 
 uint64_t SceneLibrary::check(const std::string& name, std::vector<std::string>* warnings) {
-  if (resolve(name).empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "scene");
+  if (resolve(name).empty()) throw unknown(name, "scene");
   const FileSummary file = file_summary(name);
   if (!file.error.empty()) throw JobError(JobErrorKind::scene_broken, "scene '" + name + "' does not load: " + file.error, "scene");
   if (warnings && file.summary.contains("warnings"))

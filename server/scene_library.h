@@ -53,6 +53,8 @@ class SceneLibrary {
   // The camera a job with `params` renders the scene from (its framing, or the params' pose),
   // without building the scene. Throws as check() does.
   pt::Camera view(const std::string& name, const pt::RenderParams& params);
+  // Every scene's name, sorted.
+  std::vector<std::string> names() const;
   // Every scene with its summary, or its load error, and the bytes of its built base while the
   // cache holds one.
   json list();
@@ -108,6 +110,8 @@ class SceneLibrary {
   // The cached summary or error of a scene file's current version.
   FileSummary file_summary(const std::string& name);
 
+  // "unknown scene 'cornel' (did you mean 'cornell'?)", naming `field`.
+  JobError unknown(const std::string& name, const char* field) const;
   // The scene file's name as messages show it ("cornell.dae"), from its resolved path.
   std::string file_name(const std::string& name) const;
 

@@ -42,7 +42,7 @@ std::pair<json, bool> SceneLibrary::store_upload(const std::string& name, const 
 }
 
 void SceneLibrary::remove_upload(const std::string& name) {
-  if (resolve(name).empty()) throw JobError(JobErrorKind::not_found, "unknown scene '" + name + "'", "name");
+  if (resolve(name).empty()) throw unknown(name, "name");
   if (!is_uploaded(name)) throw JobError(JobErrorKind::read_only, "'" + name + "' is a bundled scene: it cannot be deleted", "name");
   for (const char* ext : pt::kSceneExtensions) std::remove((m_upload_dir + "/" + name + ext).c_str());
   std::lock_guard<std::mutex> lock(m_mutex);

@@ -97,6 +97,10 @@ TEST(FirstRun, AMistypedOptionGetsOneLineWithTheNearestOption) {
   EXPECT_EQ(nearest_option("--keepfov"), "--keep-fov");
   EXPECT_EQ(nearest_option("--frame-scen"), "--frame-scene");
   EXPECT_EQ(nearest_option("--completely-unknown"), "");
+  // A long spelling of a one-letter flag points at the flag, beside the long option it is near.
+  EXPECT_EQ(nearest_option("--sampels"), "-s or --sampler");
+  EXPECT_EQ(nearest_option("--max-depht"), "-m");
+  EXPECT_EQ(nearest_option("--light-samples"), "-l");
   try {
     parse_cli(words("--target-eror 0.1 s.dae"));
     ADD_FAILURE() << "accepted";
@@ -137,4 +141,41 @@ TEST(FirstRun, AFileThatIsNotASceneIsNamedAsSuch) {
   EXPECT_NE(error_of("page.dae", "<html><body>hi</body></html>").find("not a COLLADA scene: the root element is <html>"),
             std::string::npos);
   EXPECT_NE(error_of("empty.dae", "").find("not a COLLADA or glTF scene (an empty file)"), std::string::npos);
+}
+
+// A folder or a mistyped file name given as the scene: the message says what it is and, for a
+// missing file, the nearest scene file's name in its folder (CBsphere.dae: CBspheres.dae).
+TEST(FirstRun, AFolderOrAMistypedSceneNameSaysWhatToGive) {
+  const std::string dir = test::temp_dir() + "/first_run_scenes";
+  test::run_command("rm -rf " + dir + " && mkdir -p " + dir);
+  for (const char* f : {"CBspheres.dae", "CBbunny.dae", "notes.txt"}) std::ofstream(dir + "/" + f) << "x";
+  auto message = [](const std::string& path) {
+    try {
+      read_scene_bytes(path);
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(read)");
+  };
+  EXPECT_EQ(message(dir), dir + ": is a folder, not a scene file (it holds CBbunny.dae, CBspheres.dae)");
+  EXPECT_EQ(message(dir + "/CBsphere.dae"),
+            dir + "/CBsphere.dae: cannot open file (no such file; did you mean " + dir + "/CBspheres.dae?)");
+  EXPECT_EQ(message(dir + "/dragon.dae"), dir + "/dragon.dae: cannot open file (no such file)");
+  // The command says the same on one line, and the Loaded line counts the default light as such.
+  test::RunResult r = test::run_command(std::string(PT_PATHTRACER) + " -f x.png " + dir + "/CBsphere.dae");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("did you mean " + dir + "/CBspheres.dae?"), std::string::npos) << r.output;
+  // One triangle, no lights, no emitters: lit by the default environment and sun.
+  const std::string unlit = dir + "/triangle.gltf", out = test::temp_dir() + "/first_run_triangle.png";
+  std::ofstream(unlit) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+  r = test::run_command(std::string(PT_PATHTRACER) + " -t 2 -s 1 -r 32 24 -f " + out + " " + unlit);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("0 spheres, no lights of its own (the default white environment and sun)"), std::string::npos)
+      << r.output;
+  r = test::run_command(std::string(PT_PATHTRACER) + " -t 2 -s 1 -r 32 24 -f " + out + " " + test::own_scene("cornell_gltf.glb"));
+  EXPECT_NE(r.output.find("0 spheres, 1 light in"), std::string::npos) << r.output;
 }

@@ -2,6 +2,7 @@
 // "s:l:t:m:e:h:H:f:r:c:b:d:a:p:" with its multi-word -r, -a and -p.
 #include "cli.h"
 
+#include "nearest.h"
 #include "options.h"
 #include "version.h"
 
@@ -48,19 +49,6 @@ double parse_option(const std::string& flag, const char* name, const std::string
   return parse_float(flag, s, o.min, o.max);
 }
 
-// Edit distance (insertions, deletions, substitutions, adjacent swaps) between two short strings.
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
-  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-  for (size_t i = 1; i <= a.size(); ++i)
-    for (size_t j = 1; j <= b.size(); ++j) {
-      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1])});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-    }
-  return d[a.size()][b.size()];
-}
-
 }  // namespace
 
 std::vector<std::string> cli_option_names() {
@@ -79,15 +67,29 @@ std::vector<std::string> cli_option_names() {
 }
 
 std::string nearest_option(const std::string& given) {
-  if (given.size() > 64) return "";
-  std::string best;
-  size_t best_d = ~size_t(0);
-  for (const std::string& name : cli_option_names()) {
-    const size_t d = edit_distance(given, name);
-    if (d < best_d) best_d = d, best = name;
+  // Long spellings of the course's one-letter flags, which a newcomer types for them (--samples
+  // for -s): the option table's names, and a few words.
+  std::vector<std::pair<std::string, std::string>> aliases = {
+      {"--samples", "-s"}, {"--threads", "-t"}, {"--output", "-f"}, {"--file", "-f"}, {"--resolution", "-r"},
+      {"--size", "-r"}, {"--environment", "-e"}, {"--cell", "-p"}, {"--camera-file", "-c"}, {"--lens-radius", "-b"},
+      {"--depth", "-m"}};
+  for (const RenderOption& o : render_options()) {
+    if (o.flag[0] != '-' || o.flag[1] == '-' || o.flag[1] == '\0') continue;
+    std::string name = std::string("--") + o.name;
+    std::replace(name.begin(), name.end(), '_', '-');
+    aliases.emplace_back(name, o.flag);
   }
-  // Close enough to be a slip: a third of the name at most (--target-eror, --keepfov, -nosamples no).
-  return best_d <= std::max<size_t>(1, best.size() / 3) ? best : "";
+  std::vector<std::string> candidates = cli_option_names();
+  for (const auto& a : aliases) candidates.push_back(a.first);
+  std::vector<std::string> picks;
+  for (const std::string& near : nearest_names(given, candidates)) {
+    std::string flag = near;
+    for (const auto& a : aliases)
+      if (a.first == near) flag = a.second;
+    if (std::find(picks.begin(), picks.end(), flag) == picks.end() && flag != given) picks.push_back(flag);
+    if (picks.size() == 2) break;
+  }
+  return picks.empty() ? "" : picks.size() == 1 ? picks[0] : picks[0] + " or " + picks[1];
 }
 
 CliOptions parse_cli(const std::vector<std::string>& args) {

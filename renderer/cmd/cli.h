@@ -36,7 +36,8 @@ class UsageError : public std::runtime_error {
 // Parses argv; throws UsageError naming the flag on anything malformed.
 CliOptions parse_cli(const std::vector<std::string>& args);
 std::string usage_text(const std::string& program);
-// The options --help lists ("-s", "--keep-fov", ...), and the one nearest a mistyped one ("" if none is near).
+// The options --help lists ("-s", "--keep-fov", ...), and the one or two nearest a mistyped one
+// ("--sampels": "-s or --sampler", for a long spelling of a one-letter flag counts; "" if none is near).
 std::vector<std::string> cli_option_names();
 std::string nearest_option(const std::string& given);
 // The debug window's keys: what to press, a brief phrase for the window's panel (which must fit a

@@ -9,6 +9,19 @@
 
 namespace pt {
 
+std::string loaded_counts(const RenderScene& scene) {
+  auto count = [](size_t n, const char* what) { return std::to_string(n) + " " + what + (n == 1 ? "" : "s"); };
+  size_t own = 0;
+  bool environment_map = false;
+  for (const Light& l : scene.lights) {
+    if (l.kind == LightKind::environment) environment_map = true;
+    else ++own;
+  }
+  std::string lights = scene.default_light ? "no lights of its own (the default white environment and sun)"
+                                           : count(own, "light") + (environment_map ? " and the environment map" : "");
+  return count(scene.triangle_count, "triangle") + ", " + count(scene.sphere_count, "sphere") + ", " + lights;
+}
+
 std::string depth_hint(int max_depth, const SceneFeatures& f) {
   auto has = [&](const char* m) { return std::find(f.materials.begin(), f.materials.end(), m) != f.materials.end(); };
   // Depth 1 is direct light only and depth 2 one bounce: a mirror shows the lit room from 2, glass

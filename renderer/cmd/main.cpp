@@ -116,8 +116,7 @@ int main(int argc, char** argv) {
     const std::vector<std::string> input_files = desc.input_files;  // for the checkpoint's fingerprint
     desc = SceneDesc();  // the render scene holds what rendering reads: drop the file's copy
     if (!o.quiet)
-      std::fprintf(stderr, "Loaded %s: %zu triangles, %zu spheres, %zu lights in %.3f s\n", o.scene_path.c_str(),
-                   scene->triangle_count, scene->sphere_count, scene->lights.size(), load_s);
+      std::fprintf(stderr, "Loaded %s: %s in %.3f s\n", o.scene_path.c_str(), loaded_counts(*scene).c_str(), load_s);
 
     doing = "for a " + std::to_string(o.params.width) + "x" + std::to_string(o.params.height) +
             " render (its per-pixel statistics and images); a smaller -r needs less";

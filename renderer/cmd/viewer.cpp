@@ -569,8 +569,7 @@ int run_viewer(const CliOptions& o) {
     p.cell_w = p.cell_h = 0;
     auto scene = make_render_scene(desc, p);
     if (!o.quiet)
-      std::fprintf(stderr, "Loaded %s: %zu triangles, %zu spheres, %zu lights\n", o.scene_path.c_str(),
-                   scene->triangle_count, scene->sphere_count, scene->lights.size());
+      std::fprintf(stderr, "Loaded %s: %s\n", o.scene_path.c_str(), loaded_counts(*scene).c_str());
     glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
     GLFWwindow* win = glfwCreateWindow(o.params.width, o.params.height, "pathtracer", nullptr, nullptr);
     if (!win) {

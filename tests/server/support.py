@@ -193,13 +193,14 @@ class Server:
     file descriptors (ulimit -n, soft and hard)."""
 
     def __init__(self, root, contract, threads=1, args=(), scenes=None, token=None, env=None, limit_file_kib=None,
-                 limit_memory_mib=None, limit_open_files=None):
+                 limit_memory_mib=None, limit_open_files=None, bundled_scenes=False):
         self.root = Path(root)
         self.token = token
         self.env = env
         self.limit_file_kib = limit_file_kib
         self.limit_memory_mib = limit_memory_mib
         self.limit_open_files = limit_open_files
+        self.bundled_scenes = bundled_scenes  # scenes/ of the source tree besides `scenes`
         self.data = self.root / "data"
         self.scenes = Path(scenes) if scenes else self.root / "scenes"
         self.contract = contract
@@ -213,6 +214,8 @@ class Server:
     def start(self, timeout=15):
         cmd = [str(RENDER_SERVER), "--port", "0", "--data", str(self.data), "--scenes", str(self.scenes),
                "--threads", str(self.threads), *self.args]
+        if not self.bundled_scenes:
+            cmd.append("--no-bundled-scenes")
         if self.token is not None:
             cmd += ["--token", self.token]
         limits = []

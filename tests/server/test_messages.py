@@ -22,6 +22,30 @@ def test_every_invalid_field_is_named_at_once(server):
     api.error(api.post("/api/jobs", dict(TINY, keep_fov=True, frame_scene=True)), 400, "frame_scene")
 
 
+def test_a_mistyped_field_or_scene_gets_the_nearest_valid_one(servers, tmp_path):
+    srv = servers("near", bundled_scenes=True)
+    api = srv.api
+    err = api.error(api.post("/api/jobs", dict(TINY, sppp=4)), 400, "sppp")
+    assert err["message"] == "unknown field 'sppp' (did you mean 'spp'?)"
+    err = api.error(api.post("/api/jobs/check", dict(TINY, max_dept=2)), 400, "max_dept")
+    assert "did you mean 'max_depth'?" in err["message"]
+    assert "did you mean" not in api.error(api.post("/api/jobs", dict(TINY, zzzzzz=1)), 400, "zzzzzz")["message"]
+    err = api.error(api.post("/api/jobs", dict(TINY, scene="cornel")), 404, "scene")
+    assert err["message"] == "unknown scene 'cornel' (did you mean 'cornell'?)"
+    # --scenes adds to the bundled scenes: the test's folder and the source tree's scenes/ both list.
+    names = {s["name"] for s in api.get("/api/scenes").json()["scenes"]}
+    assert {"cornell", "showcase", "dof"} <= names, names
+    err = api.error(api.post("/api/jobs", dict(TINY, scene="showcas")), 404, "scene")
+    assert "did you mean 'showcase'?" in err["message"]
+    # Without the bundled scenes only the folder's own are served, and the help names both flags.
+    only = {s["name"] for s in servers("only").api.get("/api/scenes").json()["scenes"]}
+    assert only == {"cornell"}, only
+    help_text = subprocess.run([str(RENDER_SERVER), "--help"], capture_output=True, text=True, timeout=10).stdout
+    assert "--no-bundled-scenes" in help_text and ".gltf, .glb" in help_text
+    bad = subprocess.run([str(RENDER_SERVER), "--scene", "x"], capture_output=True, text=True, timeout=10)
+    assert bad.returncode == 2 and "did you mean --scenes?" in bad.stderr, bad.stderr
+
+
 def test_what_the_loader_ignored_reaches_the_scene_list_and_the_jobs_status(server):
     api = server.api
     no_camera = re.sub(rb'<instance_camera url="[^"]*"/>', b"", CORNELL.read_bytes())
