@@ -199,17 +199,16 @@ function showSceneSummary() {
   }
 }
 
-// A scene's own lens: its summary's focus distance (the course camera's) and aperture, else the API's.
-function sceneLens(name) {
-  const s = sceneSummary(name) || {};
-  const d = state.defaults;
-  const pick = (...xs) => xs.find((x) => Number.isFinite(x));
-  return { aperture: pick(s.aperture, s.lens_radius, 0), focal_distance: pick(s.focal_distance, s.focus_distance, d.focal_distance) };
+// A scene carries no lens of its own (neither the course's COLLADA nor glTF has one): a switch
+// resets aperture and focal distance to the job defaults, what a job without them renders with.
+function sceneLens() {
+  const d = state.defaults || {};
+  return { aperture: d.aperture, focal_distance: d.focal_distance };
 }
 
 // The user picked another scene: the lens settings of the last one do not carry over, nor its camera.
 function onSceneChosen() {
-  const lens = sceneLens($('#f-scene').value);
+  const lens = sceneLens();
   for (const [name, v] of Object.entries(lens)) if (v !== undefined) input(name).value = String(v);
   setFormCamera(null);
   showSceneSummary();
