@@ -19,6 +19,7 @@ const nav = {
   origin: 0,         // the distance to the target the moves started at: dolly steps and limits
   ours: new Set(),   // real jobs the moves submitted: the origin carries on through them
   previews: new Set(),  // preview jobs made here: kept out of the job list
+  posting: null,     // a preview's POST while in flight (a promise of its answer)
   preview: null,     // the live preview's id
   previewView: null, // the view it renders
   drag: null,
@@ -173,13 +174,17 @@ function kickPreviews() {
         const view = nav.view;
         await dropPreview();
         if (!nav.moving) break;
-        const r = await postJson('/api/jobs', previewSpec(view), { 'Idempotency-Key': randomKey() });
+        // The job list waits on this: a list fetched meanwhile may hold the preview before its id is known.
+        nav.posting = postJson('/api/jobs', previewSpec(view), { 'Idempotency-Key': randomKey() }).then((res) => {
+          if (res && res.ok) nav.previews.add(res.data.id);
+          return res;
+        });
+        const r = await nav.posting.finally(() => { nav.posting = null; });
         nav.previewView = view;
         if (!r || !r.ok) {
           viewer.note(`No preview of this view: ${apiError(r).message}`, 'error');
           break;
         }
-        nav.previews.add(r.data.id);
         nav.preview = r.data.id;
         viewer.show(r.data.id, { preview: true });
       }

@@ -226,7 +226,10 @@ async function refreshJobs() {
     }
     const wasDown = state.pollOk === false;
     state.pollOk = true;
-    renderJobs(jobs.filter((j) => !nav.previews.has(j.id)));  // a camera move's previews come and go
+    // A camera move's previews come and go: the list leaves them out, once a preview being posted
+    // has its id (it may be in this list already).
+    while (nav.posting) await nav.posting.catch(() => null);
+    renderJobs(jobs.filter((j) => !nav.previews.has(j.id)));
     if (wasDown) onReconnected();
     updateConn();
     schedulePoll();
