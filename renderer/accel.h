@@ -128,10 +128,5 @@ constexpr float kShadowRayEnd = 1 - 1e-4f;
   r.tmin = 0;
   r.tmax = kShadowRayEnd;
 }
-inline Ray spawn_ray_to(const SurfaceHit& hit, Vec3 target) {
-  Ray r;
-  spawn_ray_to(hit, target, r);
-  return r;
-}
 
 }  // namespace pt

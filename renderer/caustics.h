@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "caustic_scene.h"
 #include "math.h"
 
 namespace pt {
@@ -26,23 +27,6 @@ struct Material;
 struct RenderParams;
 struct RenderScene;
 struct SceneDesc;
-
-// A sphere that bounds geometry with a delta material: what light paths are aimed at.
-struct CausticTarget {
-  Vec3 center;
-  float radius = 0;
-};
-
-// One bounding sphere per sphere with a delta material and one per mesh for its delta triangles;
-// past kMaxCausticTargets of them, one sphere around them all (a light path weighs every cone).
-constexpr size_t kMaxCausticTargets = 64;
-std::vector<CausticTarget> find_caustic_targets(const SceneDesc& desc, const std::vector<Material>& materials);
-
-// Whether an emitter (area light or emissive triangle) has another surface in its plane over it, as
-// the course's CBdragon has an area light and an emissive quad in one plane: where two surfaces
-// overlap, a ray sees one of them, and light paths must check which (caustics.cpp,
-// light_seen_from) or they would count both. Conservative: faces that only touch count too.
-bool emitters_share_a_plane(const SceneDesc& desc, const std::vector<Material>& materials);
 
 // Whether a view of the scene with these options renders caustics by light tracing: it needs a
 // delta material, an area or mesh light, more than one sample per pixel (one sample is the pixel

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "scene.h"
-#include "scene_file.h"
+#include "load_limits.h"
 
 namespace pt {
 

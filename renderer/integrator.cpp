@@ -44,10 +44,6 @@ bool diffuse_lanes_apply(const RenderScene& scene, const PathSettings& settings)
   return true;
 }
 
-Vec3 trace_path(const RenderScene& scene, const PathSettings& settings, Ray ray, Sampler& rng, uint64_t& rays) {
-  return trace_path_t<kFeatAll>(scene, settings, ray, rng, rays);
-}
-
 PathTracer path_tracer_for(uint32_t bits) {
   if (bits & kFeatTexture) return trace_path_t<kFeatAll>;
   static const PathTracer table[] = {

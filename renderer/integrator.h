@@ -5,29 +5,14 @@
 
 #include <cstdint>
 
+#include "path_settings.h"
 #include "render_scene.h"
 #include "sampler.h"
 
 namespace pt {
 
-// What the path loop reads of the render options, and the session's choice of who renders the
-// caustic paths: a small value the loop's every form takes instead of all of RenderParams.
-struct PathSettings {
-  int max_depth = 1;       // -m
-  int light_samples = 1;   // -l
-  bool hemisphere = false; // -H
-  // The session's light tracer renders the paths E D+ S+ L (caustics.h), so the loop leaves them out.
-  bool caustics_light_traced = false;
-
-  PathSettings() = default;
-  explicit PathSettings(const RenderParams& p, bool light_traced = false)
-      : max_depth(p.max_depth), light_samples(p.light_samples), hemisphere(p.hemisphere),
-        caustics_light_traced(light_traced) {}
-};
-
-// One camera path's radiance (integrator.cpp), by the generic loop. `rays` counts every ray cast.
-Vec3 trace_path(const RenderScene& scene, const PathSettings& settings, Ray ray, class Sampler& rng, uint64_t& rays);
-// The path loop specialised for a set of feature bits (one instantiation per combination).
+// One camera path's radiance (integrator.cpp), by the path loop specialised for a set of feature
+// bits (one instantiation per combination). `rays` counts every ray cast.
 using PathTracer = Vec3 (*)(const RenderScene&, const PathSettings&, Ray, class Sampler&, uint64_t&);
 PathTracer path_tracer_for(uint32_t feature_bits);
 // The same paths, many at once: traces camera_rays[0, n) with samplers rngs[0, n) (each already

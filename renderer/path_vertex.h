@@ -9,7 +9,8 @@
 #pragma once
 
 #include "diffuse_lanes.h"
-#include "integrator.h"
+#include "path_settings.h"
+#include "render_scene.h"
 #include "materials.h"
 #include "sampler.h"
 
@@ -21,10 +22,8 @@ using lanes::DiffuseVerticesN;
 
 namespace pt::path_loop {
 
-// Russian roulette starts at bounce 5, as Mitsuba 3's path integrator does (rr_depth = 5).
-// Starting at 3 cut rays but cost more variance than it saved time on caustic-heavy scenes:
-// efficiency on CBspheres -17% (m = 5) and -14% (m = 100), CBdragon -6%, CBbunny +6%
-// (bench/vs_mitsuba.py, docs/performance.md).
+// Russian roulette starts at bounce 5, as Mitsuba 3's path integrator does (rr_depth = 5); why
+// not 3: docs/performance.md, "Russian roulette from bounce 5".
 constexpr int kRouletteStart = 5;
 
 // BSDF dispatch reduced to the material kinds the scene has (feature bits, render_scene.h): a scene

@@ -28,12 +28,7 @@ using lane1::hash_u32;
 using lane1::laine_karras_permutation;
 using lane1::u32_to_unit;
 inline uint32_t reverse_bits32(uint32_t x) { return lane1::reverse_bits(x); }
-// With bit reversal around it, a nested uniform (Owen) scramble (Burley 2020, listing 2).
-inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
-  return reverse_bits32(laine_karras_permutation(reverse_bits32(x), seed));
-}
-// The first two Sobol dimensions: van der Corput and its (0,2)-sequence partner.
-inline uint32_t sobol_dim0(uint32_t i) { return reverse_bits32(i); }
+// The second Sobol dimension, the (0,2)-sequence partner of van der Corput's bit reversal.
 inline uint32_t sobol_dim1(uint32_t i) { return reverse_bits32(lane1::sobol_dim1_reversed_from_reversed(i)); }
 
 class Sampler {

@@ -86,8 +86,8 @@ void RenderSession::render_tile_batched(const Tile& t, int target, const std::at
   // (Sampler::sobol_draws), and its sampler starts past them.
   const bool sobol_lanes = sobol_draws_in_lanes(m_scene, p);
   const uint32_t camera_draws = (p.spp == 1 ? 0 : 1) + (lens ? 1 : 0);
-  // The batch's arrays, kept on the thread from tile to tile: allocated per tile they cost some
-  // 150 KB of fresh pages each time, about 5 ms of a pass (dof, 16 spp).
+  // The batch's arrays, kept on the thread from tile to tile: fresh pages for every tile cost a
+  // visible part of a pass.
   struct Job {
     uint32_t pixel, sample;
   };
