@@ -256,7 +256,7 @@ TEST(Caustics, OnlyEmittersThatShareAPlaneCostTheCheck) {
   for (Vec3& v : covered.meshes.back().positions) v = v + normal * 0.01f;
   EXPECT_FALSE(emitters_share_a_plane(covered, covered.materials));
   for (const char* f : {"CBdragon.dae", "CBspheres.dae", "CBbunny.dae"}) {
-    std::string path = test::shared_scene(f);
+    std::string path = test::optional_shared_scene(f);
     if (path.empty()) continue;
     SceneDesc desc = load_collada(path);
     EXPECT_EQ(emitters_share_a_plane(desc, desc.materials), std::string(f) == "CBdragon.dae") << f;

@@ -53,11 +53,14 @@ std::vector<double> estimate_over_truth_by_pass(const SceneDesc& desc, RenderPar
   return log_sum;
 }
 
+// The estimate over the truth, pass by pass from `first_spp`: within 1.5x either way; and from
+// 16 spp within [0.85, 1.5], the README's claim (the Cornell box at m = 100 and 64x48 reads 0.89
+// at 128 spp; the course scenes at 480x360 0.93-1.36: docs/performance.md, "Error estimate").
 void expect_within_1p5_from(const std::vector<double>& ratio, int first_spp) {
   int spp = 2, checked = 0;
   for (double r : ratio) {
     if (spp >= first_spp) {
-      EXPECT_GT(r, 1 / 1.5) << spp << " spp";
+      EXPECT_GT(r, spp >= 16 ? 0.85 : 1 / 1.5) << spp << " spp";
       EXPECT_LT(r, 1.5) << spp << " spp";
       ++checked;
     }

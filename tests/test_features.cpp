@@ -24,7 +24,7 @@ struct Expected {
 };
 
 std::string path_of(const Expected& e) {
-  if (e.shared) return test::shared_scene(e.file);
+  if (e.shared) return test::optional_shared_scene(e.file);
   std::string own = test::own_scene(e.file);
   if (test::file_exists(own)) return own;
   std::string built = std::string(PT_BINARY_DIR) + "/scenes/" + e.file;
@@ -105,7 +105,7 @@ TEST(Features, SpecialisedAndGenericLoopsRenderTheSameImage) {
   };
   std::vector<Case> cases = {{test::own_scene("cornell.dae"), ""}, {test::own_scene("dof.dae"), ""}};
   for (const char* f : {"CBspheres_lambertian.dae", "CBspheres_microfacet_al_ag.dae", "CBempty.dae"}) {
-    std::string p = test::shared_scene(f);
+    std::string p = test::optional_shared_scene(f);
     if (!p.empty()) cases.push_back({p, ""});
   }
   std::string env_path = test::uniform_sky("features_sky.exr", Vec3(0.3f, 0.4f, 0.6f));

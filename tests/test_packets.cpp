@@ -46,7 +46,7 @@ std::vector<Case> cases() {
   cell.cell_x = 10, cell.cell_y = 5, cell.cell_w = 30, cell.cell_h = 20;
   out.push_back({"cornell, a -p cell", test::own_scene("cornell.dae"), cell});
   for (const char* f : {"CBbunny.dae", "CBdragon.dae", "CBspheres_microfacet_al_ag.dae"}) {
-    std::string path = test::shared_scene(f);
+    std::string path = test::optional_shared_scene(f);
     if (!path.empty()) out.push_back({f, path, p});
   }
   return out;

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <sstream>
 #include <string>
@@ -78,15 +79,37 @@ inline bool file_exists(const std::string& p) {
   return stat(p.c_str(), &st) == 0;
 }
 
+// Whether the tests run under CI (CI=true), where a test that cannot run is a failure.
+inline bool under_ci() {
+  const char* ci = std::getenv("CI");
+  return ci && std::string(ci) == "true";
+}
+
 // Path of a course scene in ../shared/scenes-cs184, or "" when it is absent.
 inline std::string shared_scene(const std::string& name) {
   std::string p = std::string(PT_SHARED_SCENES) + "/" + name;
   return file_exists(p) ? p : "";
 }
 
+// For a test that cannot run here (no course scenes, no Xvfb): skipped on a user's machine, a
+// failure under CI=true, where it must never pass or skip quietly.
+#define PT_CANNOT_RUN(why)                                                       \
+  do {                                                                           \
+    if (::pt::test::under_ci()) FAIL() << "CI=true, yet this test cannot run: " << why; \
+    GTEST_SKIP() << why;                                                         \
+  } while (0)
+
+// A course scene a test covers when it is there: "" when absent, and then, under CI=true, a
+// failure (the test would pass on less than it claims).
+inline std::string optional_shared_scene(const std::string& name) {
+  std::string p = shared_scene(name);
+  if (p.empty() && under_ci()) ADD_FAILURE() << "CI=true, yet ../shared/scenes-cs184/" << name << " is absent";
+  return p;
+}
+
 #define PT_REQUIRE_SHARED_SCENE(var, name)                                      \
   std::string var = ::pt::test::shared_scene(name);                             \
-  if (var.empty()) GTEST_SKIP() << "../shared/scenes-cs184/" << name << " is absent"
+  if (var.empty()) PT_CANNOT_RUN("../shared/scenes-cs184/" << name << " is absent")
 
 // Two small spheres far apart on a diagonal, no light: most of the course framing is background,
 // including the space between them (the background mask and tile order tests).

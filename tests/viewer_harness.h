@@ -119,7 +119,7 @@ class Viewer : public ::testing::Test {
     s_xvfb = nullptr;
   }
   void SetUp() override {
-    if (!s_xvfb) GTEST_SKIP() << "Xvfb is not installed (package xvfb)";
+    if (!s_xvfb) PT_CANNOT_RUN("Xvfb is not installed (package xvfb)");
     ASSERT_EQ(s_error, "") << "cannot start Xvfb";
     m_dir = pt::test::temp_dir() + "/viewer_" + ::testing::UnitTest::GetInstance()->current_test_info()->name();
     mkdir(m_dir.c_str(), 0755);

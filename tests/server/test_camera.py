@@ -1,9 +1,12 @@
 """A job's camera field (issue: move the camera): every job shows the camera it renders from
 ('view'); that view posted back as 'camera' renders the same image, another pose another one, the
 CLI's --camera the same bits; the same vfov at half size is a smaller copy of the view, not a crop;
-bad poses are refused by name; the view survives a restart and is in the EXR."""
+bad poses are refused by name; the view survives a restart and is in the EXR; focus off the image
+centre finds the surface under that pixel (no flipped axis)."""
+import base64
 import json
 import math
+import struct
 
 from images import read_exr, render_cli
 from support import CORNELL, TINY
@@ -127,3 +130,35 @@ def test_bad_poses_are_refused_by_name(server):
     job = api.submit(dict(TINY, camera=dict(base, up=None, vfov=None)))
     assert job["spec"]["camera"]["up"] == [0, 1, 0] and job["spec"]["camera"]["vfov"] is None
     assert job["view"]["position"] == [0, 1, 5] and job["view"]["vfov"] > 0
+
+
+def planes_gltf():
+    """Three quads facing +Z, seen from (0, 0, 10): the left half of the view at depth 10, the top
+    right quarter at 15, the bottom right at 20. A flipped axis of the focus query shows."""
+    quads = [(-20, 0, -20, 20, 0.0), (0, 20, 0, 20, -5.0), (0, 20, -20, 0, -10.0)]
+    pos = []
+    for x0, x1, y0, y1, z in quads:
+        for x, y in ((x0, y0), (x1, y0), (x1, y1), (x0, y0), (x1, y1), (x0, y1)):
+            pos += [x, y, z]
+    data = struct.pack(f"<{len(pos)}f", *pos)
+    return json.dumps({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(pos) // 3, "type": "VEC3",
+                       "min": [-20, -20, -10], "max": [20, 20, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": len(data)}],
+        "buffers": [{"byteLength": len(data),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+    }).encode()
+
+
+def test_focus_off_the_image_centre_finds_the_surface_under_that_pixel(server):
+    api = server.api
+    api.request("PUT", "/api/scenes/planes", 201, data=planes_gltf(), headers={"Content-Type": "model/gltf+json"})
+    job = api.submit({"scene": "planes", "width": 64, "height": 48, "spp": 1,
+                      "camera": {"position": [0, 0, 10], "target": [0, 0, 0], "vfov": 40}})
+    api.wait(job["id"], "done", timeout=60)
+    # x from the left, y from the top, as the page's clicks: depth along the view axis.
+    for x, y, depth in ((16, 12, 10), (16, 36, 10), (48, 12, 15), (48, 36, 20), (63, 47, 20), (1, 1, 10)):
+        got = api.get(f"/api/jobs/{job['id']}/focus?x={x}&y={y}").json()["distance"]
+        assert math.isclose(got, depth, rel_tol=1e-3), f"focus at ({x}, {y}): {got}, expected {depth}"

@@ -267,3 +267,38 @@ def test_a_camera_field_reaches_the_worker(cluster, servers):
     assert single.api.wait(framed_id, {"done", "failed"}, timeout=90)["state"] == "done"
     _, _, framed, _ = image(single.api, framed_id)
     assert sum(abs(a - b) for a, b in zip(framed["G"], ref["G"])) > 0.05 * sum(ref["G"])
+
+
+def test_a_pass_rendered_twice_is_merged_once(cluster):
+    """A worker stopped while it holds a pass looks dead: another claims and renders the pass. Woken
+    again, the first one finishes it too and sends its copy: the server merges only the first."""
+    srv, workers, redis = cluster(2)
+    api = srv.api
+    wait_for(lambda: api.get("/api/health").json()["workers"] == 2, "two workers announced")
+    spec = dict(JOB, spp=512)  # long enough that the second copy arrives while the job runs
+    job_id = api.submit(spec)["id"]
+    sleeper, deadline = None, time.monotonic() + 60
+    while sleeper is None:  # as in the kill test: stopped while it still holds a pass
+        assert time.monotonic() < deadline, "no worker ever held a pass"
+        assert api.job(job_id)["state"] in ("queued", "running")
+        candidate = next((w for w in workers if redis.pending_by_worker().get(w.name, 0) > 0), None)
+        if candidate is not None:
+            candidate.proc.send_signal(signal.SIGSTOP)
+            time.sleep(0.05)
+            if redis.pending_by_worker().get(candidate.name, 0) > 0:
+                sleeper = candidate
+            else:
+                candidate.proc.send_signal(signal.SIGCONT)
+        time.sleep(0.02)
+    other = next(w for w in workers if w is not sleeper)
+    wait_for(lambda: "left by another worker" in other.text(), "the other worker claimed the held pass", 30)
+    claimed = re.search(rf"claimed pass (\d+) of job {job_id}", other.text()).group(1)
+    wait_for(lambda: re.search(rf"job {job_id} pass {claimed}: samples", other.text()), "the claimed pass rendered", 60)
+    sleeper.proc.send_signal(signal.SIGCONT)
+    wait_for(lambda: re.search(rf"job {job_id} pass {claimed}: samples", sleeper.text()), "the woken worker's copy", 60)
+    assert api.job(job_id)["state"] == "running", "the job ended before the second copy came: nothing was tested"
+    done = api.wait(job_id, {"done", "failed", "cancelled"}, timeout=300)
+    assert done["state"] == "done", done
+    assert done["samples"] == spec["width"] * spec["height"] * spec["spp"], "a pass was merged twice"
+    counts = struct.unpack(f"<{spec['width'] * spec['height'] * 4}f", api.get(f"/api/jobs/{job_id}/pixels").content)[3::4]
+    assert set(counts) == {spec["spp"]}, "a pixel's count is not the job's spp"
