@@ -1,14 +1,16 @@
 """Our glTF test scenes for bench/vs_cycles.py, built in Blender with bpy and written by Blender's
 own glTF exporter, as a user's would be (run inside build/cycles-venv, which vs_cycles.py makes):
 
-    build/cycles-venv/bin/python bench/blender_scenes.py [OUTDIR]    (default build/cycles-scenes)
+    build/cycles-venv/bin/python bench/blender_scenes.py [OUTDIR [NAME ...]]    (default build/cycles-scenes, all)
 
 Each scene has a camera (4:3) and a black world; its textures are generated here and packed into
 the .glb (128x128 PNGs). The scenes: mr_grid (a 5x5 metallic/roughness sphere grid under an
 emissive panel), plastic (dielectric specular layer at roughness 0.05, 0.2, 0.5), textured (checker
 base colour, metallic-roughness and normal-map textures), glass (transmission at roughness 0 and
 0.3), clearcoat (over a red base), punctual (point, spot and sun lights on diffuse objects), alpha
-(a cut-out leaf, a fading card, a card of constant alpha), sheen (cloth-like spheres).
+(a cut-out leaf, a fading card, a card of constant alpha), sheen (cloth-like spheres), volume (glass
+slabs of three thicknesses absorbing inside, KHR_materials_volume), unlit (an unlit card standing
+under the panel beside a diffuse sphere, KHR_materials_unlit).
 Blender's exporter orders vertices differently from run to run (the same triangles), so a rewritten
 scene has a new content hash and vs_cycles.py renders new references for it.
 """
@@ -22,6 +24,7 @@ import numpy as np
 from mathutils import Vector
 
 from cycles_render import quiet_stdout
+from io_scene_gltf2.blender.com.material_helpers import create_settings_group, get_gltf_node_name
 
 ROOT = Path(__file__).resolve().parents[1]
 TEX = 128  # texture size, texels a side
@@ -305,14 +308,60 @@ def punctual():
     camera((0, -5.5, 2.5), (0, 0.5, 0.6), 45)
 
 
+def volume():
+    """KHR_materials_volume: upright slabs of smooth glass 0.1, 0.25 and 0.5 m thick (along the view),
+    sharing one material whose Volume Absorption (amber, density 2 /m) feeds the output's Volume
+    socket. The exporter writes the extension only from a glTF Material Output group with a
+    non-zero Thickness (Add > Output > glTF Material Output): attenuationDistance = 1 / density."""
+    stage()
+    mat = material("amber glass", (1, 1, 1), Roughness=0.0, Transmission_Weight=1.0, IOR=1.5)
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    absorb = nodes.new("ShaderNodeVolumeAbsorption")
+    absorb.inputs["Color"].default_value = (0.9, 0.55, 0.2, 1)
+    absorb.inputs["Density"].default_value = 2.0
+    links.new(absorb.outputs["Volume"], nodes["Material Output"].inputs["Volume"])
+    settings = nodes.new("ShaderNodeGroup")  # as the add-on's menu operator makes it
+    settings.node_tree = bpy.data.node_groups.get(get_gltf_node_name()) or create_settings_group(get_gltf_node_name())
+    settings.inputs["Thickness"].default_value = 0.25
+    for i, thickness in enumerate((0.1, 0.25, 0.5)):
+        box(f"slab {thickness:g} m", mat, ((i - 1) * 1.3, 0, 0.51), (0.9, thickness, 1.0))
+    camera((0, -4.5, 2.0), (0, 0, 0.5), 40)
+
+
+def unlit():
+    """KHR_materials_unlit: an orange card standing under the panel, made as the exporter detects it
+    (Mix Shader of Light Path 'Is Camera Ray': Transparent BSDF, else Emission of the colour), beside
+    a diffuse sphere; the card's shadow (if any) falls on the floor towards the camera."""
+    stage()
+    mat = bpy.data.materials.new("unlit orange")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.remove(nodes["Principled BSDF"])
+    path, mix = nodes.new("ShaderNodeLightPath"), nodes.new("ShaderNodeMixShader")
+    transparent, emission = nodes.new("ShaderNodeBsdfTransparent"), nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (0.9, 0.35, 0.05, 1)
+    links.new(path.outputs["Is Camera Ray"], mix.inputs["Fac"])
+    links.new(transparent.outputs[0], mix.inputs[1])
+    links.new(emission.outputs[0], mix.inputs[2])
+    links.new(mix.outputs[0], nodes["Material Output"].inputs["Surface"])
+    plane("unlit card", mat, (-0.7, -2.8, 0.5), (1.2, 1.0), (math.radians(90), 0, 0))
+    sphere("diffuse sphere", material("white", (0.75, 0.75, 0.75), Roughness=1.0), (0.8, -1.5, 0.55), 0.55)
+    camera((0, -6.5, 2.4), (0, -1.8, 0.4), 40)
+
+
 SCENES = {"mr_grid": mr_grid, "plastic": plastic, "textured": textured, "glass": glass, "clearcoat": clearcoat,
-          "punctual": punctual, "alpha": alpha, "sheen": sheen}
+          "punctual": punctual, "alpha": alpha, "sheen": sheen,
+          "volume": volume, "unlit": unlit}
 
 
 def main():
     out = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "build" / "cycles-scenes"
+    names = sys.argv[2:] or list(SCENES)
+    unknown = [n for n in names if n not in SCENES]
+    if unknown:
+        sys.exit(f"blender_scenes: unknown scene {unknown[0]} (known: {', '.join(SCENES)})")
     out.mkdir(parents=True, exist_ok=True)
-    for name, build in SCENES.items():
+    for name in names:
+        build = SCENES[name]
         reset()
         build()
         path = out / f"{name}.glb"

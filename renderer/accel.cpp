@@ -157,22 +157,6 @@ HitAttributes interpolate(const GeomInfo& g, uint32_t prim, float u, float v) {
   return out;
 }
 
-// A uniform number in [0, 1) from a ray and a triangle: the same ray meets the same triangle with
-// the same answer (packets and single rays agree, renders repeat), different rays independently.
-inline uint32_t mix32(uint32_t h) {  // a 32-bit finaliser (Wellons' "lowbias32")
-  h ^= h >> 16, h *= 0x7feb352du, h ^= h >> 15, h *= 0x846ca68bu, h ^= h >> 16;
-  return h;
-}
-inline float ray_uniform(const float* f, int n, uint32_t prim) {
-  uint32_t h = mix32(prim * 0x9e3779b9u + 1);
-  for (int i = 0; i < n; ++i) {
-    uint32_t bits;
-    std::memcpy(&bits, &f[i], 4);
-    h = mix32(h ^ bits);
-  }
-  return float(h >> 8) * 0x1p-24f;
-}
-
 }  // namespace
 
 struct Accel::Impl {
@@ -193,7 +177,8 @@ struct Accel::Impl {
   int packet_width = 16;
   bool attributes = false;  // some mesh has uvs or colours: hits interpolate them
   CoverageTest coverage;             // alpha-tested materials (Embree filters on their meshes)
-  std::vector<uint8_t> tested;       // per material: alpha-tested
+  std::vector<uint8_t> tested;       // per material: kAlphaTested | kUnlit (Embree filters on their meshes)
+  bool unlit = false;                // some material is unlit
 
   void check(const char* what) {
     std::lock_guard<std::mutex> lock(error.mutex);
@@ -207,9 +192,13 @@ struct Accel::Impl {
 
 namespace {
 
-// Embree's filter on meshes with alpha-tested triangles, for intersect and occluded queries of
-// every width: a hit the coverage test refuses is ignored and traversal goes on behind it.
-void alpha_filter(const RTCFilterFunctionNArguments* args) {
+constexpr uint8_t kAlphaTested = 1, kUnlit = 2;
+constexpr unsigned kCameraRay = 1;  // RTCRay::id of a ray that leaves the camera
+
+// Embree's filter on meshes with alpha-tested or unlit triangles, for intersect and occluded
+// queries of every width: a hit the coverage test refuses, or an unlit one by a ray that is not a
+// camera ray, is ignored and traversal goes on behind it.
+void see_through_filter(const RTCFilterFunctionNArguments* args) {
   const auto& a = *static_cast<const Accel::Impl*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
@@ -217,6 +206,11 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     const GeomInfo& g = a.geoms[geom];
     const int material = g.tris[prim].material;
     if (material < 0 || size_t(material) >= a.tested.size() || !a.tested[size_t(material)]) continue;
+    if ((a.tested[size_t(material)] & kUnlit) && RTCRayN_id(args->ray, args->N, i) != kCameraRay) {
+      args->valid[i] = 0;
+      continue;
+    }
+    if (!(a.tested[size_t(material)] & kAlphaTested)) continue;
     const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
     const float ray[6] = {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
                           RTCRayN_org_z(args->ray, args->N, i), RTCRayN_dir_x(args->ray, args->N, i),
@@ -231,15 +225,17 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
              const std::vector<std::vector<int>>& mesh_light, CoverageTest coverage)
     : m_impl(std::make_unique<Impl>()) {
   Impl& a = *m_impl;
-  if (coverage) {
-    a.tested.resize(desc.materials.size());
-    bool any = false;
-    for (size_t m = 0; m < desc.materials.size(); ++m) {
-      const Material& mat = desc.materials[m];
-      any |= a.tested[m] = mat.type == MaterialType::pbr && mat.pbr.alpha_tested();
-    }
-    if (any) a.coverage = std::move(coverage);
+  a.tested.resize(desc.materials.size());
+  bool any_alpha = false;
+  for (size_t m = 0; m < desc.materials.size(); ++m) {
+    const Material& mat = desc.materials[m];
+    if (mat.type != MaterialType::pbr) continue;
+    const bool alpha = coverage && mat.pbr.alpha_tested();
+    a.tested[m] = uint8_t((alpha ? kAlphaTested : 0) | (mat.pbr.unlit ? kUnlit : 0));
+    any_alpha |= alpha;
+    a.unlit |= mat.pbr.unlit;
   }
+  if (any_alpha) a.coverage = std::move(coverage);
   a.device = rtcNewDevice(nullptr);
   if (!a.device) throw std::runtime_error("Embree: cannot create device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
   rtcSetDeviceErrorFunction(a.device, on_device_error, &a.error);
@@ -253,13 +249,13 @@ Accel::Accel(const SceneDesc& desc, const std::vector<EmitterPanel>& panels,
   auto add_triangles = [&](const std::vector<Vec3>& pos, const std::vector<uint32_t>& idx,
                            const std::vector<int>& tri_material, const std::vector<int>& tri_light, GeomInfo info) {
     RTCGeometry g = rtcNewGeometry(a.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    bool alpha = false;
-    for (size_t t = 0; a.coverage && t < tri_material.size() && !alpha; ++t)
-      alpha = tri_material[t] >= 0 && size_t(tri_material[t]) < a.tested.size() && a.tested[size_t(tri_material[t])];
-    if (alpha) {
+    bool filtered = false;
+    for (size_t t = 0; t < tri_material.size() && !filtered; ++t)
+      filtered = tri_material[t] >= 0 && size_t(tri_material[t]) < a.tested.size() && a.tested[size_t(tri_material[t])];
+    if (filtered) {
       rtcSetGeometryUserData(g, &a);
-      rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
-      rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
+      rtcSetGeometryIntersectFilterFunction(g, see_through_filter);
+      rtcSetGeometryOccludedFilterFunction(g, see_through_filter);
     }
     auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                            3 * sizeof(float), pos.size()));
@@ -394,15 +390,11 @@ size_t Accel::memory_bytes() const {
 
 namespace {
 
-inline void to_embree(const Ray& r, RTCRay& e) {
-  e.org_x = r.o.x; e.org_y = r.o.y; e.org_z = r.o.z;
-  e.dir_x = r.d.x; e.dir_y = r.d.y; e.dir_z = r.d.z;
-  e.tnear = r.tmin;
-  e.tfar = r.tmax;
-  e.time = 0;
-  e.mask = 0xFFFFFFFFu;
-  e.id = 0;
-  e.flags = 0;
+inline void to_embree(const Ray& r, RTCRay& e, unsigned id = 0) {
+  e.org_x = r.o.x, e.org_y = r.o.y, e.org_z = r.o.z;
+  e.dir_x = r.d.x, e.dir_y = r.d.y, e.dir_z = r.d.z;
+  e.tnear = r.tmin, e.tfar = r.tmax;
+  e.time = 0, e.mask = 0xFFFFFFFFu, e.id = id, e.flags = 0;
 }
 
 // The hit record from Embree's answer (accel_math.h). `eng()` gives Embree's unnormalised
@@ -464,8 +456,9 @@ struct Lanes {
   int used = 0;
 
   template <class Rays, class RayK>
-  bool add(const Rays& rays, uint32_t i, RayK& packet) {
+  bool add(const Rays& rays, uint32_t i, RayK& packet, unsigned id = 0) {
     to_lane(rays[i], packet, used);
+    packet.id[used] = id;
     ray[used] = i;
     return ++used == K;
   }
@@ -480,7 +473,8 @@ struct Lanes {
 };
 
 template <int K, bool Attributes>
-void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) {
+void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found,
+                       const uint8_t* camera) {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   alignas(64) typename Packet<K>::RayHit rh;
@@ -504,7 +498,7 @@ void intersect_packets(const Accel::Impl& a, const Ray* rays, size_t stride, siz
     const Ray& r = at[i];
     if (!embree_accepts(r) || (a.cull && !may_hit_bounds(r, a.lo, a.hi))) continue;
     rh.hit.geomID[lanes.used] = rh.hit.instID[0][lanes.used] = RTC_INVALID_GEOMETRY_ID;
-    if (lanes.add(at, uint32_t(i), rh.ray)) trace();
+    if (lanes.add(at, uint32_t(i), rh.ray, camera && camera[i] ? kCameraRay : 0)) trace();
   }
   if (lanes.used) trace();
 }
@@ -533,14 +527,14 @@ void occluded_packets(const Accel::Impl& a, const Ray* rays, size_t n, uint8_t* 
 
 }  // namespace
 
-bool Accel::intersect(const Ray& ray, SurfaceHit& hit) const {
+bool Accel::intersect(const Ray& ray, SurfaceHit& hit, bool camera) const {
   if (!embree_accepts(ray)) return false;
   const Impl& a = *m_impl;
   if (a.cull && !may_hit_bounds(ray, a.lo, a.hi)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
-  to_embree(ray, rh.ray);
+  to_embree(ray, rh.ray, camera ? kCameraRay : 0);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(m_impl->scene, &ctx, &rh);
@@ -568,16 +562,19 @@ bool Accel::occluded(const Ray& ray) const {
   return r.tfar < 0;  // Embree sets tfar = -inf on a hit
 }
 
-void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const {
+void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found,
+                           const uint8_t* camera) const {
   const Impl& a = *m_impl;
   if (a.packet_width == 16) {
-    if (a.attributes) intersect_packets<16, true>(a, rays, stride, n, hits, found);
-    else intersect_packets<16, false>(a, rays, stride, n, hits, found);
+    if (a.attributes) intersect_packets<16, true>(a, rays, stride, n, hits, found, camera);
+    else intersect_packets<16, false>(a, rays, stride, n, hits, found, camera);
   } else {
-    if (a.attributes) intersect_packets<8, true>(a, rays, stride, n, hits, found);
-    else intersect_packets<8, false>(a, rays, stride, n, hits, found);
+    if (a.attributes) intersect_packets<8, true>(a, rays, stride, n, hits, found, camera);
+    else intersect_packets<8, false>(a, rays, stride, n, hits, found, camera);
   }
 }
+
+bool Accel::has_unlit() const { return m_impl->unlit; }
 
 void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {
   if (m_impl->packet_width == 16) occluded_packets<16>(*m_impl, rays, n, blocked);

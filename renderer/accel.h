@@ -63,7 +63,9 @@ class Accel {
   Accel(const Accel&) = delete;
   Accel& operator=(const Accel&) = delete;
 
-  bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  // `camera`: the ray leaves the camera. Unlit surfaces (KHR_materials_unlit) are seen by camera
+  // rays only, as Blender renders them: every other ray, shadow rays included, passes through.
+  bool intersect(const Ray& ray, SurfaceHit& hit, bool camera = false) const;
   // The vertex attributes at a hit on a mesh that carries them (SurfaceHit::geom, prim, bu, bv).
   HitAttributes attributes(const SurfaceHit& hit) const;
   // True when anything blocks the ray within [ray.tmin, ray.tmax].
@@ -78,7 +80,11 @@ class Accel {
   }
   // The same with ray i at byte offset i * stride from `rays`: rays inside the caller's records
   // (the path pool's states) are read where they are, not copied out first.
-  void intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found) const;
+  // camera[i] (when given): ray i leaves the camera.
+  void intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found,
+                      const uint8_t* camera = nullptr) const;
+  // Whether a ray's camera flag matters: the scene has unlit surfaces.
+  bool has_unlit() const;
   void occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const;
   // Rays per Embree packet in intersect_many / occluded_many: Embree's native width, 16 on
   // AVX-512 and 8 below it. set_packet_width (8 or 16) overrides it, for tests.

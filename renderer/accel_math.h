@@ -319,4 +319,20 @@ template <bool Attributes = true, class EmbreeNormal>
 #endif
 }
 
+// A uniform number in [0, 1) from a ray and a triangle: the same ray meets the same triangle with
+// the same answer (packets and single rays agree, renders repeat), different rays independently.
+inline uint32_t mix32(uint32_t h) {  // a 32-bit finaliser (Wellons' "lowbias32")
+  h ^= h >> 16, h *= 0x7feb352du, h ^= h >> 15, h *= 0x846ca68bu, h ^= h >> 16;
+  return h;
+}
+inline float ray_uniform(const float* f, int n, uint32_t prim) {
+  uint32_t h = mix32(prim * 0x9e3779b9u + 1);
+  for (int i = 0; i < n; ++i) {
+    uint32_t bits;
+    std::memcpy(&bits, &f[i], 4);
+    h = mix32(h ^ bits);
+  }
+  return float(h >> 8) * 0x1p-24f;
+}
+
 }  // namespace pt

@@ -27,7 +27,7 @@ Vec3 trace_path_t(const RenderScene& scene, const PathSettings& settings, Ray ra
   for (;;) {
     SurfaceHit hit;
     ++rays;
-    bool found = scene.accel->intersect(st.ray, hit);
+    bool found = scene.accel->intersect(st.ray, hit, st.bounce == 0);
     bool more = path_step<F>(scene, settings, st, found, hit, rng, rays, shadow, diffuse_lit);
     st.resolve_direct();
     if (!more) return st.radiance;

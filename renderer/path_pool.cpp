@@ -137,6 +137,7 @@ void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const
 
     std::vector<SurfaceHit> hits = std::vector<SurfaceHit>(kSlots);
     std::vector<uint8_t> found = std::vector<uint8_t>(kSlots), alive = std::vector<uint8_t>(kSlots), blocked;
+    std::vector<uint8_t> camera = std::vector<uint8_t>(kSlots);  // a slot's ray leaves the camera (unlit surfaces)
     ShadowBatch shadows;
   };
   static thread_local Pool pool;
@@ -161,7 +162,11 @@ void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const
     const size_t m = live;
     rays += m;
     // The rays where they lie in the slots (PathState::ray), not copied out.
-    scene.accel->intersect_many(&slots[0].st.ray, sizeof(Slot), m, hits.data(), found.data());
+    const bool unlit = scene.accel->has_unlit();  // only then does a ray's origin matter to Embree
+    if (unlit)
+      for (size_t i = 0; i < m; ++i) pool.camera[i] = slots[i].st.bounce == 0;
+    scene.accel->intersect_many(&slots[0].st.ray, sizeof(Slot), m, hits.data(), found.data(),
+                                unlit ? pool.camera.data() : nullptr);
     shadows.n = 0;
     size_t n_lanes = 0;  // slots the lanes take: a diffuse hit with depth left
     for (size_t i = 0; i < m; ++i) {

@@ -355,7 +355,7 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
 float autofocus_distance(const RenderScene& scene, float sx, float sy) {
   Ray r = scene.camera.pinhole_ray(sx, sy);
   SurfaceHit hit;
-  if (!scene.accel->intersect(r, hit)) return kInf;
+  if (!scene.accel->intersect(r, hit, true)) return kInf;  // what the camera sees, unlit surfaces too
   // The thin lens focuses on a plane at a depth along the view axis, not at a distance along the
   // ray: an off-centre hit's distance would put the plane behind it by 1 / cos of the ray's angle.
   const float depth = dot(hit.p - r.o, -scene.camera.back);

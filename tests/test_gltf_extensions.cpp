@@ -1,5 +1,5 @@
 // KHR_materials_unlit and KHR_materials_volume in renders: an unlit surface shows its base colour
-// to the camera whatever the light and lights nothing; light crossing a volume's mesh is attenuated
+// to the camera whatever the light, lights nothing and, as Blender renders it, casts no shadow; light crossing a volume's mesh is attenuated
 // by Beer-Lambert's law, attenuationColor after attenuationDistance.
 #include <gtest/gtest.h>
 
@@ -67,6 +67,34 @@ TEST(GltfExtensions, UnlitShowsItsBaseColourAndLightsNothing) {
   add_camera(g, 3);
   const ImageRGB img = render(g.text(), 16, 3);
   EXPECT_LT(centre(img, 1).mean, 1e-6) << "an unlit surface lit the floor";
+}
+
+// Blender's importer makes an unlit material transparent to every ray but camera rays: a card
+// between the sun and the floor casts no shadow there. The same card opaque does (the test sees a
+// shadow when there is one).
+TEST(GltfExtensions, UnlitCastsNoShadow) {
+  auto floor_centre = [](const char* card) {
+    GltfDoc g = test::quad_doc();
+    g.doc["materials"][0]["extensions"]["KHR_materials_specular"] = {{"specularFactor", 0}};
+    g.doc["nodes"][0]["scale"] = {3, 3, 1};
+    add_camera(g, 3);
+    // The sun along (-1, 0, -1) / sqrt 2: a card at (2, 0, 2) facing it, outside the camera's view,
+    // shadows the floor's centre.
+    const double q = std::sin(M_PI / 8), w = std::cos(M_PI / 8);
+    g.light(json{{"type", "directional"}, {"intensity", 6830}}, json{{"rotation", {0, q, 0, w}}});
+    if (card) {
+      json m = {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 0.5, 0.2, 1}}}}, {"doubleSided", true}};
+      if (std::string(card) == "unlit") m["extensions"] = {{"KHR_materials_unlit", json::object()}};
+      const json& prim = g.doc["meshes"][0]["primitives"][0];
+      g.mesh(json{{"POSITION", prim["attributes"]["POSITION"]}}, prim["indices"], g.material(m),
+             json{{"translation", {2, 0, 2}}, {"rotation", {0, q, 0, w}}, {"scale", {0.8, 0.8, 1}}});
+    }
+    return centre(render(g.text(), 64, 2), 1).mean;
+  };
+  const double open = floor_centre(nullptr), unlit = floor_centre("unlit"), opaque = floor_centre("opaque");
+  ASSERT_GT(open, 0.05);
+  EXPECT_LT(opaque, 0.5 * open) << "the opaque card casts no shadow: the test's geometry is off";
+  EXPECT_NEAR(unlit / open, 1.0, 0.02) << "an unlit card shadows the floor";
 }
 
 // A glass box (transmission 1, ior 1.01: almost no reflection, no bending) 1 unit thick before an
