@@ -4,12 +4,12 @@
 #include <atomic>
 #include <cstdio>
 #include <stdexcept>
-#include <thread>
 
 #include <sys/mman.h>
 
 #include "caustics.h"
 #include "film_pass.h"
+#include "parallel.h"
 
 namespace pt {
 
@@ -376,19 +376,21 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
   const size_t blocks = (h + rows_per_block - 1) / rows_per_block;
   std::vector<double> sums(blocks, 0.0);
   std::vector<size_t> useds(blocks, 0);
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t b; (b = next.fetch_add(1)) < blocks;)
-      block(b * rows_per_block, std::min(h, (b + 1) * rows_per_block), sums[b], useds[b]);
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min<int>(threads, int(blocks)); ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  parallel_indices(blocks, threads, [&](auto& take) {
+    for (size_t b; take(b);) block(b * rows_per_block, std::min(h, (b + 1) * rows_per_block), sums[b], useds[b]);
+  });
   double sum = 0;
   size_t used = 0;
   for (size_t b = 0; b < blocks; ++b) sum += sums[b], used += useds[b];
   return used ? sum / double(n_pixels) : INFINITY;
+}
+
+std::vector<Tile> tile_grid(int w, int h, int size) {
+  std::vector<Tile> tiles;
+  size = std::max(1, size);
+  for (int y = 0; y < h; y += size)
+    for (int x = 0; x < w; x += size) tiles.push_back({x, y, std::min(x + size, w), std::min(y + size, h)});
+  return tiles;
 }
 
 std::string format_error_estimate(double error) {

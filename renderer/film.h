@@ -23,6 +23,10 @@ struct Tile {
   int x0, y0, x1, y1;  // film pixels, top-left origin, half-open
 };
 
+// A w x h film cut into tiles of `size` pixels a side (the last row and column clipped), row by
+// row from the top-left: the session's passes and the scale-out's merges cut it the same way.
+std::vector<Tile> tile_grid(int w, int h, int size);
+
 // The course's sample-rate colour of a pixel (linear, before tone mapping): 0 samples blue,
 // spp / 2 green, spp red. The rate image and the window's rate legend both use it.
 Vec3 rate_colour(uint32_t count, int spp);

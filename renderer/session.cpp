@@ -7,11 +7,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <thread>
 
 #include <time.h>
 
 #include "materials.h"
+#include "parallel.h"
 #include "sampler.h"
 
 namespace pt {
@@ -44,9 +44,7 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
       m_film(film_width(params), film_height(params), params.spp, adaptive_rule(params), m_path.caustics_light_traced) {
   const int w = width(), h = height();
   if (m_path.caustics_light_traced) m_caustic_film = {params.width, params.height, m_frame_x0, m_frame_y0, w, h};
-  int ts = params.tile_size;
-  for (int y = 0; y < h; y += ts)
-    for (int x = 0; x < w; x += ts) m_tiles.push_back({x, y, std::min(x + ts, w), std::min(y + ts, h)});
+  m_tiles = tile_grid(w, h, params.tile_size);
   find_scene_rectangle();
   // Before any pass, a tile's cost is its pixels that see the scene.
   m_tile_ns.assign(m_tiles.size(), 0);
@@ -206,23 +204,17 @@ void RenderSession::trace_caustics(int target, const std::atomic<bool>* cancel) 
     const size_t in_wave = size_t(std::min(kWave, chunks - wave));
     for (auto& s : splats) s.clear();
     std::fill(finished.begin(), finished.end(), 0);
-    std::atomic<size_t> next{0};
-    auto worker = [&]() {
+    parallel_indices(in_wave, m_params.threads, [&](auto& take) {
       const uint64_t cpu_start = thread_cpu_ns();
       uint64_t rays = 0;
-      for (size_t c; (c = next.fetch_add(1)) < in_wave && !stop_requested(cancel);) {
+      for (size_t c; take(c) && !stop_requested(cancel);) {
         uint64_t b = first + (wave + c) * kChunk, e = std::min(first + count, b + kChunk);
         trace_caustic_paths(m_scene, m_params, m_caustic_film, b, e - b, splats[c], rays);
         finished[c] = 1;
       }
       m_rays += rays;
       m_cpu_ns += thread_cpu_ns() - cpu_start;
-    };
-    int nthreads = std::max(1, std::min<int>(m_params.threads, int(in_wave)));
-    std::vector<std::thread> pool;
-    for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
+    });
     size_t c = 0;
     for (; c < in_wave && finished[c]; ++c, ++merged) {
       m_film.add_splats(splats[c]);
@@ -242,13 +234,10 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
     trace_caustics(target_spp, cancel);
     m_light_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
-  std::atomic<size_t> next{0};
-  auto worker = [&]() {
+  parallel_indices(m_tile_order.size(), m_params.threads, [&](auto& take) {
     const uint64_t cpu_start = thread_cpu_ns();
     uint64_t rays = 0, samples = 0, nonfinite = 0;
-    for (;;) {
-      const size_t k = next.fetch_add(1);
-      if (k >= m_tile_order.size()) break;
+    for (size_t k; take(k);) {
       if (stop_requested(cancel)) break;
       const uint32_t ti = m_tile_order[k];
       const auto t0 = std::chrono::steady_clock::now();
@@ -262,12 +251,7 @@ bool RenderSession::render_pass(int target_spp, const std::atomic<bool>* cancel,
     m_samples += samples;
     m_nonfinite += nonfinite;
     m_cpu_ns += thread_cpu_ns() - cpu_start;
-  };
-  int nthreads = std::max(1, std::min<int>(m_params.threads, int(m_tiles.size())));
-  std::vector<std::thread> pool;
-  for (int i = 1; i < nthreads; ++i) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  });
   order_tiles_by_cost();
   m_film.invalidate_estimate();  // also for an estimate someone asked for while the pass ran
   m_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -136,9 +136,7 @@ class WorkerPasses : public pt::PassSource {
         // the scene decides whether passes carry caustics; plan for the larger
         m_plan(m_params.spp, size_t(m_w) * m_h, m_params.caustic_tracing ? 32.0 : 20.0),
         m_film(m_w, m_h, m_params.spp, pt::adaptive_rule(m_params), false) {
-    const int ts = m_params.tile_size;
-    for (int y = 0; y < m_h; y += ts)
-      for (int x = 0; x < m_w; x += ts) m_tiles.push_back({x, y, std::min(x + ts, m_w), std::min(y + ts, m_h)});
+    m_tiles = pt::tile_grid(m_w, m_h, m_params.tile_size);
   }
   // However the render ends, workers learn the run is over.
   ~WorkerPasses() override {
