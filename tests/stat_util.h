@@ -33,6 +33,12 @@ inline double chi2_critical(int dof, double alpha) {
   return dof * std::pow(1 - h + z * std::sqrt(h), 3);
 }
 
+// The significance each of `tests` chi-square tests is run at so that all of them together fail
+// by chance with probability `family` (Šidák 1967, "Rectangular confidence regions for the means
+// of multivariate normal distributions"), as pbrt-v4's and Mitsuba 3's chi-square tests do.
+// Each test file states how many it runs (PT_CHI2_DEBUG=1 prints every one).
+inline double sidak_alpha(double family, int tests) { return 1 - std::pow(1 - family, 1.0 / tests); }
+
 struct Chi2Result {
   bool passed = false;
   double statistic = 0, critical = 0;

@@ -23,7 +23,8 @@ using pt::test::chi2_test;
 
 namespace {
 
-constexpr double kAlpha = 1e-3;
+// Its 8 chi-square tests fail by chance together with probability 0.01.
+const double kAlpha = pt::test::sidak_alpha(0.01, 8);
 constexpr int kSamples = 200000;
 
 // The render scene of `desc` with `lights` added; a small far sphere keeps the scene non-empty.
