@@ -16,36 +16,12 @@ using namespace pt;
 
 namespace {
 
-// A scene with one box from (-1,0,-1) to (1,1.5,1) and the course's Cornell-box camera node.
-SceneDesc box_scene() {
-  SceneDesc s;
-  MeshDesc m;
-  m.positions = {{-1, 0, -1}, {1, 0, -1}, {1, 1.5f, 1}};
-  m.indices = {0, 1, 2};
-  m.tri_material = {0};
-  s.meshes.push_back(m);
-  s.materials.push_back(Material());
-  s.camera.present = true;
-  s.camera.xfov_deg = 49.13434f;
-  s.camera.aspect = 1.333333f;
-  s.camera.znear = 0.1f;
-  s.camera.zfar = 100;
-  // Course camera matrix (Z-up file) with the Z_UP conversion applied on top.
-  Mat4 file = Mat4::zero();
-  double v[16] = {-1, 0, 0, 0, 0, 0, 1, 3, 0, 1, 0, 0, 0, 0, 0, 1};
-  for (int i = 0; i < 16; ++i) file.m[i / 4][i % 4] = v[i];
-  Mat4 up = Mat4::zero();
-  up.m[0][0] = -1; up.m[1][2] = 1; up.m[2][1] = 1; up.m[3][3] = 1;
-  s.camera.world = up * file;
-  return s;
-}
-
 float dist(Vec3 a, Vec3 b) { return length(a - b); }
 
 }  // namespace
 
 TEST(Camera, CourseFramingOrbitsTheBoundingBox) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   Camera c = make_camera(s, CameraParams());
   // Centre (0, 0.75, 0), diagonal sqrt(4 + 2.25 + 4) = 3.2016, distance 1.5 x that = 4.802.
   EXPECT_NEAR(c.position.x, 0, 1e-5);
@@ -56,7 +32,7 @@ TEST(Camera, CourseFramingOrbitsTheBoundingBox) {
 }
 
 TEST(Camera, ResizeKeepsThePixelAngle) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   CameraParams p;
   Camera full = make_camera(s, p);
   p.width = 400;
@@ -72,7 +48,7 @@ TEST(Camera, ResizeKeepsThePixelAngle) {
 }
 
 TEST(Camera, ThinLensRaysFromOnePixelMeetOnTheFocalPlane) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   CameraParams p;
   p.lens_radius = 0.25f;
   p.focal_distance = 3.0f;
@@ -101,7 +77,7 @@ TEST(Camera, ThinLensRaysFromOnePixelMeetOnTheFocalPlane) {
 // What light tracing splats by: the sensor point whose ray from a given lens point passes through
 // a world point, for points at every depth (in front of and behind the plane of focus).
 TEST(Camera, SensorPointInvertsGenerateRay) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   for (float radius : {0.0f, 0.25f}) {
     CameraParams p;
     p.lens_radius = radius;
@@ -126,7 +102,7 @@ TEST(Camera, SensorPointInvertsGenerateRay) {
 }
 
 TEST(Camera, ZeroLensRadiusIsExactlyThePinhole) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   CameraParams p;
   p.lens_radius = 0;
   Camera c = make_camera(s, p);
@@ -140,7 +116,7 @@ TEST(Camera, ZeroLensRadiusIsExactlyThePinhole) {
 }
 
 TEST(Camera, FileCameraUsesTheAuthoredPose) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   CameraParams p;
   p.file_camera = true;
   Camera c = make_camera(s, p);
@@ -156,7 +132,7 @@ TEST(Camera, FileCameraUsesTheAuthoredPose) {
 }
 
 TEST(Camera, SettingsFileRoundTrip) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   CameraParams p;
   p.width = 320;
   p.height = 200;
@@ -181,7 +157,7 @@ TEST(Camera, BadSettingsFileNamesTheField) {
   CameraParams p;
   p.settings_file = path;
   try {
-    make_camera(box_scene(), p);
+    make_camera(test::camera_box_scene(), p);
     FAIL() << "expected an error";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("cam_bad.txt"), std::string::npos) << e.what();
@@ -209,7 +185,7 @@ TEST(Camera, CBdragonDefaultFocusIsOnTheDragon) {
 }
 
 TEST(Camera, KeepFovScalesTheCourseViewInsteadOfCropping) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   CameraParams p;
   Camera full = make_camera(s, p);
   p.width = 480;
@@ -229,7 +205,7 @@ Camera tilted_camera(Vec3 back) {
   CameraParams cp;
   cp.width = 480;
   cp.height = 360;
-  Camera c = make_camera(box_scene(), cp);
+  Camera c = make_camera(test::camera_box_scene(), cp);
   Frame tilted(normalize(back));
   c.right = tilted.s, c.up = tilted.t, c.back = tilted.n;
   return c;
@@ -309,7 +285,7 @@ TEST(Camera, ThinLensRaysInLanesAreGenerateRaysBits) {
 // --frame-scene keeps the course's view direction and fits the field of view to the projected
 // bounds: all of the box is in the image, and a 5% narrower view would cut some of it off.
 TEST(Camera, FrameSceneFitsTheProjectedBoundsToTheImage) {
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   CameraParams p;
   p.width = 480;
   p.height = 360;

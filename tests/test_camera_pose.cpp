@@ -14,18 +14,6 @@ using namespace pt;
 
 namespace {
 
-// One triangle spanning (-1,0,-1)..(1,1.5,1): the course framing orbits its bounds.
-SceneDesc box_scene() {
-  SceneDesc s;
-  MeshDesc m;
-  m.positions = {{-1, 0, -1}, {1, 0, -1}, {1, 1.5f, 1}};
-  m.indices = {0, 1, 2};
-  m.tri_material = {0};
-  s.meshes.push_back(m);
-  s.materials.push_back(Material());
-  return s;
-}
-
 CameraParams sized(int w, int h) {
   CameraParams p;
   p.width = w;
@@ -51,7 +39,7 @@ CameraPose pose_of(Vec3 position, Vec3 target, float vfov = 0) {
 }  // namespace
 
 TEST(CameraPose, ReplacesTheFramingAndKeepsItsFieldOfView) {
-  const SceneDesc s = box_scene();
+  const SceneDesc s = test::camera_box_scene();
   CameraParams p = sized(320, 240);
   const Camera framed = make_camera(s, p);
   p.pose = pose_of(Vec3(3, 1, 2), Vec3(0, 0.5f, 0));
@@ -68,7 +56,7 @@ TEST(CameraPose, ReplacesTheFramingAndKeepsItsFieldOfView) {
 
 TEST(CameraPose, TheSameVfovIsTheSameViewAtAnySize) {
   // What the page's half-size sweeps rely on: a smaller copy of the view, not a crop of it.
-  const SceneDesc s = box_scene();
+  const SceneDesc s = test::camera_box_scene();
   CameraParams big = sized(320, 240), small = sized(160, 120);
   big.pose = small.pose = pose_of(Vec3(0, 2, 5), Vec3(0, 0.5f, 0), 30);
   const Camera a = make_camera(s, big), b = make_camera(s, small);
@@ -80,7 +68,7 @@ TEST(CameraPose, TheSameVfovIsTheSameViewAtAnySize) {
 
 TEST(CameraPose, AResolvedViewPostedBackIsTheSameCamera) {
   // A job's status shows the camera it renders from; the page orbits from it and posts it back.
-  const SceneDesc s = box_scene();
+  const SceneDesc s = test::camera_box_scene();
   for (bool frame : {false, true}) {
     CameraParams p = sized(200, 100);
     p.frame_scene = frame;
@@ -98,7 +86,7 @@ TEST(CameraPose, AResolvedViewPostedBackIsTheSameCamera) {
 }
 
 TEST(CameraPose, UpTiltsTheImage) {
-  const SceneDesc s = box_scene();
+  const SceneDesc s = test::camera_box_scene();
   CameraParams p = sized(100, 100);
   p.pose = pose_of(Vec3(0, 0, 5), Vec3(0, 0, 0));
   p.pose.up = Vec3(1, 0, 0);  // a quarter turn: image up is world +X
@@ -109,7 +97,7 @@ TEST(CameraPose, UpTiltsTheImage) {
 
 TEST(CameraPose, APoseDropsTheFilesClipRange) {
   // A glTF camera's znear / zfar fit where it was authored, not where the user moved it.
-  SceneDesc s = box_scene();
+  SceneDesc s = test::camera_box_scene();
   s.camera.present = true;
   s.camera.as_authored = true;
   s.camera.yfov_deg = 40;

@@ -111,6 +111,30 @@ inline std::string optional_shared_scene(const std::string& name) {
   std::string var = ::pt::test::shared_scene(name);                             \
   if (var.empty()) PT_CANNOT_RUN("../shared/scenes-cs184/" << name << " is absent")
 
+// A scene with one box from (-1,0,-1) to (1,1.5,1) and the course's Cornell-box camera node.
+inline SceneDesc camera_box_scene() {
+  SceneDesc s;
+  MeshDesc m;
+  m.positions = {{-1, 0, -1}, {1, 0, -1}, {1, 1.5f, 1}};
+  m.indices = {0, 1, 2};
+  m.tri_material = {0};
+  s.meshes.push_back(m);
+  s.materials.push_back(Material());
+  s.camera.present = true;
+  s.camera.xfov_deg = 49.13434f;
+  s.camera.aspect = 1.333333f;
+  s.camera.znear = 0.1f;
+  s.camera.zfar = 100;
+  // Course camera matrix (Z-up file) with the Z_UP conversion applied on top.
+  Mat4 file = Mat4::zero();
+  double v[16] = {-1, 0, 0, 0, 0, 0, 1, 3, 0, 1, 0, 0, 0, 0, 0, 1};
+  for (int i = 0; i < 16; ++i) file.m[i / 4][i % 4] = v[i];
+  Mat4 up = Mat4::zero();
+  up.m[0][0] = -1; up.m[1][2] = 1; up.m[2][1] = 1; up.m[3][3] = 1;
+  s.camera.world = up * file;
+  return s;
+}
+
 // Two small spheres far apart on a diagonal, no light: most of the course framing is background,
 // including the space between them (the background mask and tile order tests).
 inline SceneDesc two_small_spheres() {
