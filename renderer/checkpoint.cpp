@@ -90,13 +90,13 @@ std::string render_fingerprint(const std::string& scene_bytes, const RenderParam
   return f.str();
 }
 
-void save_checkpoint(const std::string& path, const std::string& fingerprint, const RenderSession& session,
+void save_checkpoint(const std::string& path, const std::string& fingerprint, const PassSource& source,
                      const ProgressiveDriver& driver) {
   BinaryWriter out;
   for (char c : kMagic) out.pod(c);
   out.text(fingerprint);
   driver.save(out);
-  session.save(out);
+  source.save(out);
   const std::string tmp = path + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) fail_io(tmp, "create");
@@ -122,7 +122,7 @@ void save_checkpoint(const std::string& path, const std::string& fingerprint, co
   }
 }
 
-bool restore_checkpoint(const std::string& path, const std::string& fingerprint, RenderSession& session,
+bool restore_checkpoint(const std::string& path, const std::string& fingerprint, PassSource& source,
                         ProgressiveDriver& driver) {
   std::ifstream file(path, std::ios::binary);
   if (!file) {
@@ -139,18 +139,30 @@ bool restore_checkpoint(const std::string& path, const std::string& fingerprint,
     throw std::runtime_error(path + ": a checkpoint of another render (its scene file or an option that changes the "
                              "image differs); delete it or name another file.\n  checkpoint: " + theirs +
                              "\n  this run:   " + fingerprint);
-  driver.restore(in);
-  session.restore(in);
-  if (!in.at_end()) in.fail("bytes past the end");
+  // A damaged file fails part way through: the state before it is put back, so that a caller that
+  // goes on (the job service renders from the start) has a fresh source, whichever source it is.
+  BinaryWriter before;
+  driver.save(before);
+  source.save(before);
+  try {
+    driver.restore(in);
+    source.restore(in);
+    if (!in.at_end()) in.fail("bytes past the end");
+  } catch (...) {
+    BinaryReader back(before.bytes(), path);
+    driver.restore(back);
+    source.restore(back);
+    throw;
+  }
   driver.reopen();
   return true;
 }
 
-bool Checkpointer::after_pass(const RenderSession& session, const ProgressiveDriver& driver, bool force) {
+bool Checkpointer::after_pass(const PassSource& source, const ProgressiveDriver& driver, bool force) {
   using clock = std::chrono::steady_clock;
   const auto now = clock::now();
   if (!force && std::chrono::duration<double>(now - m_last).count() < m_interval) return false;
-  save_checkpoint(m_path, m_fingerprint, session, driver);
+  save_checkpoint(m_path, m_fingerprint, source, driver);
   m_last = clock::now();
   m_save_seconds += std::chrono::duration<double>(m_last - now).count();
   ++m_saves;

@@ -1,7 +1,8 @@
-// Checkpoints of a long render: the film, the session's counts and the driver's next pass, written
-// atomically between passes. A render restored from one continues exactly where it stood: each
-// sample's random numbers depend only on the seed, the pixel and the sample index, and the film
-// holds every statistic the stop rules and the error estimate read, so the finished image is the
+// Checkpoints of a long render: the pass source's state (a session's film and counts, or the
+// scale-out server's merged film and passes) and the driver's next pass, written atomically between
+// passes. A render restored from one continues exactly where it stood: each sample's random
+// numbers depend only on the seed, the pixel and the sample index, and the film holds every
+// statistic the stop rules and the error estimate read, so the finished image is the
 // uninterrupted render's, bit for bit.
 #pragma once
 
@@ -9,7 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "session.h"
+#include "driver.h"
+#include "options.h"
 
 namespace pt {
 
@@ -21,11 +23,12 @@ std::string render_fingerprint(const std::string& scene_bytes, const RenderParam
                                const std::vector<std::string>& input_files = {});
 
 // Writes the checkpoint to `path` (a temporary file, flushed to disk, then renamed over it).
-void save_checkpoint(const std::string& path, const std::string& fingerprint, const RenderSession& session,
+void save_checkpoint(const std::string& path, const std::string& fingerprint, const PassSource& source,
                      const ProgressiveDriver& driver);
-// Restores a fresh session and driver from `path`: false when there is no file there; throws
-// std::runtime_error naming the file when it is not a checkpoint of this render or is damaged.
-bool restore_checkpoint(const std::string& path, const std::string& fingerprint, RenderSession& session,
+// Restores a fresh source and its driver from `path`: false when there is no file there; throws
+// std::runtime_error naming the file when it is not a checkpoint of this render or is damaged, and
+// then leaves both as they were.
+bool restore_checkpoint(const std::string& path, const std::string& fingerprint, PassSource& source,
                         ProgressiveDriver& driver);
 
 // Checkpoints of one render at pass ends: the CLI's --checkpoint and the job service's jobs.
@@ -34,13 +37,13 @@ class Checkpointer {
   // Saves to `path` at most every `interval` seconds (0: after every pass).
   Checkpointer(std::string path, std::string fingerprint, double interval)
       : m_path(std::move(path)), m_fingerprint(std::move(fingerprint)), m_interval(interval) {}
-  // restore_checkpoint into a fresh session and driver.
-  bool restore(RenderSession& session, ProgressiveDriver& driver) const {
-    return restore_checkpoint(m_path, m_fingerprint, session, driver);
+  // restore_checkpoint into a fresh source and driver.
+  bool restore(PassSource& source, ProgressiveDriver& driver) const {
+    return restore_checkpoint(m_path, m_fingerprint, source, driver);
   }
   // After a pass: saves when `force` is set or the interval has passed since the last save.
   // Returns whether it saved.
-  bool after_pass(const RenderSession& session, const ProgressiveDriver& driver, bool force = false);
+  bool after_pass(const PassSource& source, const ProgressiveDriver& driver, bool force = false);
   const std::string& path() const { return m_path; }
   int saves() const { return m_saves; }
   double save_seconds() const { return m_save_seconds; }  // time spent saving, in all

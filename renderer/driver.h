@@ -10,10 +10,16 @@
 
 #include "film.h"
 #include "options.h"
+#include "binary_io.h"
 
 namespace pt {
 
 using TileCallback = std::function<void(const Tile&)>;
+
+// What a render has taken so far, for reports and logs.
+struct RenderCounts {
+  uint64_t samples = 0, rays = 0, nonfinite = 0;
+};
 
 // What a progressive render runs on: a session rendering passes here (session.h), or the
 // scale-out's server gathering workers' passes (server/redis_backend.cpp).
@@ -35,6 +41,13 @@ class PassSource {
   virtual double light_seconds() const { return 0; }
   // Nothing left to render: every pixel done (gathered: also every pass asked for merged).
   virtual bool finished() const { return film().finished(); }
+  virtual RenderCounts counts() const = 0;
+  // The tiles on_tile reports, covering the film: what a front end republishes in full.
+  virtual const std::vector<Tile>& tiles() const = 0;
+  // Checkpoints (checkpoint.h): everything the render has taken, its film included. save() between
+  // passes; restore() before the first pass, into a source of the same render.
+  virtual void save(BinaryWriter& out) const = 0;
+  virtual void restore(BinaryReader& in) = 0;
 };
 
 enum class StopReason { finished, target_error, time_limit, cancelled };

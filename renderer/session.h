@@ -55,6 +55,10 @@ class RenderSession : public PassSource {
   // Each sample left weighted by its tile's time per sample in the last pass that reached it.
   Film::Work work() const override;
   double light_seconds() const override { return m_light_seconds; }  // since this object began
+  RenderCounts counts() const override { return {m_samples.load(), m_rays.load(), m_nonfinite.load()}; }
+  const std::vector<Tile>& tiles() const override { return m_tiles; }
+  void save(BinaryWriter& out) const override;
+  void restore(BinaryReader& in) override;
 
   const RenderParams& params() const { return m_params; }
   const RenderScene& scene() const { return m_scene; }
@@ -65,12 +69,6 @@ class RenderSession : public PassSource {
   ImageRGB image() const { return m_film.image(); }
   ImageRGB rate_image() const { return m_film.rate_image(); }
   SessionStats stats() const;
-  const std::vector<Tile>& tiles() const { return m_tiles; }
-
-  // Checkpoints (checkpoint.h): what the session has rendered, its film included. save() between
-  // passes; restore() before the first pass, into a session of the same scene and options.
-  void save(BinaryWriter& out) const;
-  void restore(BinaryReader& in);
 
   // For one share of a distributed render: sample indices start at `first` (so disjoint ranges
   // merge into the single-machine image; the caustic light paths follow the same share) and pixels

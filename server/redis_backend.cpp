@@ -155,29 +155,23 @@ class WorkerPasses : public pt::PassSource {
   bool finished() const override {
     return m_film.finished() || (m_plan.exhausted() && m_merged.size() == m_plan.issued());
   }
-  RenderReport report(double error, pt::ProgressEstimate& estimate) const {
-    const double t = seconds();
-    estimate.update(*this, t, error);
-    return {estimate.progress(t), m_samples, m_rays, m_nonfinite, error, estimate.remaining_seconds(t)};
-  }
-  // After the last advance: the sink has started, and the log has the job's merge costs.
-  void finish(pt::StopReason why);
+  pt::RenderCounts counts() const override { return {m_samples, m_rays, m_nonfinite}; }
+  const std::vector<pt::Tile>& tiles() const override { return m_tiles; }
   // Checkpoints: the merged film, the passes issued and which of them were merged. A restored run
   // (a new run id) issues again the passes that were out when the server stopped.
-  void save(pt::BinaryWriter& out) const;
-  void restore(pt::BinaryReader& in);
-  void reset();  // back to no pass, after a restore that failed part way
+  void save(pt::BinaryWriter& out) const override;
+  void restore(pt::BinaryReader& in) override;
+  // After the last advance: the sink has started, and the log has the job's merge costs.
+  void finish(pt::StopReason why);
   // After a restore: the sink starts with the checkpoint's time and the job's features.
   void resumed(const std::vector<std::string>& features) {
     m_sink.started(m_w, m_h, features, m_seconds_before);
     m_started = true;
   }
-  bool started() const { return m_started; }
-  uint64_t samples() const { return m_samples; }
-  const std::vector<pt::Tile>& tiles() const { return m_tiles; }
 
  private:
   using clock = std::chrono::steady_clock;
+  bool gather(const std::atomic<bool>* cancel, const pt::TileCallback& on_tile);  // advance's work
   void issue(size_t unit);
   void publish();
   bool merge(const RedisReply& r);  // true when a pass was merged
@@ -215,18 +209,11 @@ void WorkerPasses::save(pt::BinaryWriter& out) const {
   m_film.save(out);
 }
 
-void WorkerPasses::reset() {
-  m_plan = PassPlan(m_params.spp, size_t(m_w) * m_h, m_params.caustic_tracing ? 32.0 : 20.0);
-  m_film = pt::Film(m_w, m_h, m_params.spp, pt::adaptive_rule(m_params), false);
-  m_merged.clear();
-  m_samples = m_rays = m_nonfinite = 0;
-  m_seconds_before = 0;
-}
-
 void WorkerPasses::restore(pt::BinaryReader& in) {
   m_plan.restore(in);
   const uint64_t n = in.pod<uint64_t>();
   if (n > m_plan.issued()) in.fail("more passes merged than issued");
+  m_merged.clear();
   for (uint64_t k = 0; k < n; ++k) {
     const uint32_t u = in.pod<uint32_t>();
     if (u >= m_plan.issued()) in.fail("a pass never issued");
@@ -304,6 +291,15 @@ bool WorkerPasses::merge(const RedisReply& r) {
 }
 
 bool WorkerPasses::advance(int, const std::atomic<bool>* cancel, const pt::TileCallback& on_tile) {
+  try {
+    return gather(cancel, on_tile);
+  } catch (const RedisUnreachable&) {
+    if (cancel && cancel->load()) return false;  // cancelled (or the server stopping) while waiting
+    throw;  // away past --redis-timeout: the job fails, saying so
+  }
+}
+
+bool WorkerPasses::gather(const std::atomic<bool>* cancel, const pt::TileCallback& on_tile) {
   for (;;) {
     // Keep every live worker busy plus a few passes queued, each carrying the pixels converged so
     // far. The worker count is looked up at most once a second.
@@ -371,89 +367,21 @@ class RedisBackend : public RenderBackend {
     RedisClient redis(m_address, 5.0, false);
     redis.set_patience(m_redis_timeout, &stop, "render-server: job " + job.id);
     WorkerPasses passes(job, scene_text, redis, sink, [this] { return live_workers(); }, m_in_flight);
-    const std::string fingerprint = pt::render_fingerprint(scene_text, spec.params);
-    auto on_tile = [&](const pt::Tile& t) {
-      thread_local std::vector<pt::Vec3> buf;
-      thread_local std::vector<uint32_t> count;
-      passes.film().read_tile(t, buf);
-      passes.film().read_tile_count(t, count);
-      sink.tile(t, buf, count);
-    };
-    pt::ProgressEstimate estimate({spec.time_limit, spec.target_error});
-    if (!plan.path.empty() && restore(plan.path, fingerprint, job, passes)) {
-      std::vector<std::string> features;
-      {
-        std::lock_guard<std::mutex> lock(job.mutex);
-        features = job.features;
-      }
-      passes.resumed(features);
-      for (const pt::Tile& t : passes.tiles()) on_tile(t);
-      sink.pass(passes.report(passes.error_estimate(), estimate));
-    }
-    RenderResult result;
-    auto last_save = std::chrono::steady_clock::now();
-    auto save = [&](bool force) {
-      const auto now = std::chrono::steady_clock::now();
-      if (plan.path.empty() || !passes.started() ||
-          (!force && std::chrono::duration<double>(now - last_save).count() < plan.interval))
-        return;
-      last_save = now;
-      try {
-        pt::BinaryWriter out;
-        out.text(kCheckpointMagic), out.text(fingerprint);
-        passes.save(out);
-        write_file_atomic(plan.path, out.bytes());
-        sink.checkpointed(passes.samples(), passes.seconds());
-      } catch (const std::exception& e) {  // costs the resume, not the render
-        std::fprintf(stderr, "render-server: job %s: %s\n", job.id.c_str(), e.what());
-      }
-    };
-    pt::ProgressiveDriver driver(passes, {spec.time_limit, spec.target_error});
-    try {
-      while (!driver.done()) {
-        const pt::PassReport r = driver.step(&stop, on_tile);
-        sink.pass(passes.report(r.error, estimate));
-        if (!r.completed) break;
-        save(false);
-      }
-      result.why = driver.done() ? driver.reason() : pt::StopReason::cancelled;
-    } catch (const RedisUnreachable&) {
-      if (!stop) throw;  // away past --redis-timeout: the job fails, saying so
-      result.why = pt::StopReason::cancelled;  // cancelled (or the server stopping) while waiting
-    }
-    save(true);  // a pause, a restart or a continue takes the merged film from here
+    RenderResult result = render_job(passes, job, sink, stop, plan, pt::render_fingerprint(scene_text, spec.params),
+                                     [&](bool resumed) {
+                                       if (!resumed) return;  // the first merged pass starts the sink
+                                       std::vector<std::string> features;
+                                       {
+                                         std::lock_guard<std::mutex> lock(job.mutex);
+                                         features = job.features;
+                                       }
+                                       passes.resumed(features);
+                                     });
     passes.finish(result.why);
-    result.image = passes.film().image();
-    result.report = passes.report(passes.error_estimate(), estimate);
-    result.seconds = passes.seconds();
     return result;
   }
 
  private:
-  static constexpr const char* kCheckpointMagic = "render-server merged film 1";
-
-  // The job's checkpoint into `passes`: false when there is none, or it is another render's or
-  // damaged (said in the log; the job renders from the start).
-  static bool restore(const std::string& path, const std::string& fingerprint, const Job& job, WorkerPasses& passes) {
-    std::string bytes;
-    if (!read_file(path, bytes)) return false;
-    try {
-      pt::BinaryReader in(bytes, path);
-      if (in.text(64) != kCheckpointMagic) in.fail("not a merged film");
-      if (in.text(1 << 16) != fingerprint) in.fail("a checkpoint of another render");
-      passes.restore(in);
-      if (!in.at_end()) in.fail("bytes past the end");
-      std::fprintf(stderr, "render-server: job %s: resuming from its checkpoint (%.1f spp a pixel, %.2f s rendered)\n",
-                   job.id.c_str(), double(passes.samples()) / double(passes.film().pixels()),
-                   passes.seconds());
-      return true;
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "render-server: job %s: %s; rendering from the start\n", job.id.c_str(), e.what());
-      passes.reset();
-      return false;
-    }
-  }
-
   SceneLibrary& m_scenes;
   RedisAddress m_address;
   int m_in_flight;

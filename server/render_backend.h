@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +53,14 @@ struct CheckpointPlan {
   std::string path;  // "" for none
   double interval = 30;
 };
+
+// A job's render on `source` through the renderer's render lifecycle (renderer/render_job.h):
+// checkpoints at `plan` for the render `fingerprint` names, tiles, passes and checkpoints reported
+// to `sink`. `started` tells the sink the film's size and the scene's features (each backend knows
+// them its own way), before the first pass, with whether a checkpoint was restored.
+RenderResult render_job(pt::PassSource& source, const Job& job, JobSink& sink, const std::atomic<bool>& stop,
+                        const CheckpointPlan& plan, const std::string& fingerprint,
+                        const std::function<void(bool resumed)>& started);
 
 class RenderBackend {
  public:

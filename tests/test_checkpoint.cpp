@@ -1,5 +1,6 @@
-// The CLI's checkpoints (renderer/checkpoint.h): a killed render resumes to the same bits, a larger
-// budget continues a finished one, another render's or a damaged checkpoint is refused.
+// Checkpoints (renderer/checkpoint.h) through the CLI and the render lifecycle (render_job.h): a
+// killed render resumes to the same bits, a larger budget continues a finished one, another
+// render's or a damaged checkpoint is refused, or, where the caller goes on, leaves the render fresh.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -11,6 +12,9 @@
 #include <fstream>
 #include <regex>
 
+#include "render_job.h"
+#include "scene_file.h"
+#include "session.h"
 #include "test_util.h"
 
 namespace pt {
@@ -154,6 +158,40 @@ TEST(Checkpoint, AGltfWhoseBufferChangedIsAnotherRender) {
   EXPECT_EQ(changed.status, 1) << changed.output;
   EXPECT_NE(changed.output.find("a checkpoint of another render"), std::string::npos) << changed.output;
   EXPECT_NE(changed.output.find("quad.bin"), std::string::npos) << "it names the file: " << changed.output;
+}
+
+// The job service's way: a checkpoint of this render cut short fails part way through the film, and
+// the render goes on from the start (restore_failed set) to the bits of a render that never saw the
+// file; a restored film's first values would change them.
+TEST(Checkpoint, ADamagedCheckpointLeavesTheRenderFresh) {
+  const std::string dir = test::temp_dir() + "/checkpoint_rollback", path = dir + "/c.ckpt";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  RenderParams p;
+  p.width = 32, p.height = 24, p.spp = 8, p.max_depth = 3, p.threads = 2, p.adaptive = false;
+  auto scene = make_render_scene(load_scene(test::own_scene("cornell.dae")), p);
+  auto render = [&](bool* failed) {
+    RenderSession session(*scene, p);
+    Checkpointer checkpoints(path, "this render", 0);
+    RenderJobEvents events;
+    if (failed) events.restore_failed = [failed](const std::exception&) { *failed = true; };
+    EXPECT_EQ(run_render_job(session, {}, &checkpoints, nullptr, events), StopReason::finished);
+    return session.image();
+  };
+  const ImageRGB whole = render(nullptr);
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  ASSERT_GT(bytes.size(), 1000u);
+  std::ofstream(path, std::ios::binary) << bytes.substr(0, bytes.size() * 3 / 4);  // inside the film's arrays
+  bool failed = false;
+  const ImageRGB again = render(&failed);
+  EXPECT_TRUE(failed) << "the cut file was restored";
+  ASSERT_EQ(whole.pixels.size(), again.pixels.size());
+  EXPECT_EQ(std::memcmp(whole.pixels.data(), again.pixels.data(), whole.pixels.size() * sizeof(whole.pixels[0])), 0)
+      << "the render did not start from nothing";
 }
 
 }  // namespace

@@ -26,22 +26,22 @@ struct SyntheticRender : PassSource {
   Film m_film;
   std::vector<Pcg32> rng;
   std::vector<double> s1, s2;
-  std::vector<Tile> tiles;
+  std::vector<Tile> tile_list;
   std::vector<uint64_t> tile_ns, tile_samples;
   double clock = 0, light_clock = 0;  // light_clock: the part of clock spent on light paths
   SyntheticRender(int w, int h, int spp, AdaptiveRule rule)
       : m_film(w, h, spp, rule, false), rng(size_t(w) * h), s1(rng.size()), s2(rng.size()),
-        tiles{{0, 0, w / 2, h}, {w / 2, 0, w, h}}, tile_ns(2), tile_samples(2) {
+        tile_list{{0, 0, w / 2, h}, {w / 2, 0, w, h}}, tile_ns(2), tile_samples(2) {
     for (size_t i = 0; i < rng.size(); ++i) rng[i] = Pcg32(i, 7);
   }
   template <class Draw, class Cost>
   void pass(uint32_t target, Draw draw, Cost cost) {
     uint64_t nonfinite = 0;
-    for (size_t t = 0; t < tiles.size(); ++t) {
+    for (size_t t = 0; t < tile_list.size(); ++t) {
       const double start = clock;
       tile_samples[t] = 0;
-      for (int y = tiles[t].y0; y < tiles[t].y1; ++y)
-        for (int x = tiles[t].x0; x < tiles[t].x1; ++x) {
+      for (int y = tile_list[t].y0; y < tile_list[t].y1; ++y)
+        for (int x = tile_list[t].x0; x < tile_list[t].x1; ++x) {
           const size_t i = size_t(y) * m_film.width() + x;
           while (!m_film.done(i) && m_film.count(i) < target) {
             const Vec3 l(float(draw(i, rng[i])));
@@ -64,7 +64,11 @@ struct SyntheticRender : PassSource {
   void set_deadline(std::chrono::steady_clock::time_point) override {}
   const Film& film() const override { return m_film; }
   double seconds() const override { return clock; }
-  Film::Work work() const override { return m_film.work(tiles, tile_ns, tile_samples); }
+  Film::Work work() const override { return m_film.work(tile_list, tile_ns, tile_samples); }
+  RenderCounts counts() const override { return {}; }
+  const std::vector<Tile>& tiles() const override { return tile_list; }
+  void save(BinaryWriter& out) const override { m_film.save(out); }
+  void restore(BinaryReader& in) override { m_film.restore(in); }
   double light_seconds() const override { return light_clock; }
   // Caustic light paths for a pass from `from` to `to` samples a pixel: `per_sample` a sample,
   // `cost` seconds each.
@@ -278,7 +282,7 @@ TEST(ProgressEstimate, WeighsTheSamplesLeftByTheirTilesCost) {
   // The tiles' costs alone, as the film reads them: the dear half's samples weigh 1.5, the
   // cheap half's 0.5.
   const std::vector<uint64_t> ns{1000, 3000}, samples{10, 10};
-  const Film::Work w = r.film().work(r.tiles, ns, samples);
+  const Film::Work w = r.film().work(r.tile_list, ns, samples);
   EXPECT_EQ(w.left, 100u * 48);
   EXPECT_NEAR(w.cost_left, 50 * 48 * 0.5 + 50 * 48 * 1.5, 1e-9);
 }

@@ -11,12 +11,12 @@
 #include <new>
 #include <string>
 
-#include "checkpoint.h"
 #include "cli.h"
 #include "scene_file.h"
 #include "diffuse_lanes.h"
 #include "hints.h"
 #include "progress.h"
+#include "render_job.h"
 #include "session.h"
 #include "version.h"
 #include "viewer.h"
@@ -137,27 +137,19 @@ int main(int argc, char** argv) {
     }
     ProgressBar bar("Rendering", !o.quiet);
     double pixels = double(session.width()) * session.height();
-    // The driver stepped here rather than by run_progressive: a checkpoint goes between passes.
-    ProgressiveDriver driver(session, o.limits);
     std::unique_ptr<Checkpointer> checkpoints;
-    bool restored = false;
     if (!o.checkpoint.empty()) {
       std::ifstream scene_file(o.scene_path, std::ios::binary);
       checkpoints = std::make_unique<Checkpointer>(
           o.checkpoint, render_fingerprint(std::string(std::istreambuf_iterator<char>(scene_file), {}), o.params, input_files),
           o.checkpoint_interval);
-      restored = checkpoints->restore(session, driver);
-      if (restored && !o.quiet)
-        std::fprintf(stderr, "Resuming from %s: %.1f spp a pixel, %.2f s rendered\n", o.checkpoint.c_str(),
-                     session.stats().samples / pixels, session.seconds());
     }
     // The bar, its log and the ETA follow the render's ProgressEstimate (driver.h), on a clock of
     // rendering time that goes on from a checkpoint's, as the time limit does.
-    const double resumed = session.seconds();
-    const auto render_start = std::chrono::steady_clock::now();
+    double resumed = 0;
+    auto render_start = std::chrono::steady_clock::now();
     auto clock = [&] { return resumed + std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count(); };
     ProgressEstimate estimate(o.limits);
-    if (restored) estimate.update(session, resumed, session.error_estimate());
     std::atomic<double> last_error{INFINITY};
     FILE* progress_log = nullptr;
     if (!o.progress_log.empty()) {
@@ -176,7 +168,15 @@ int main(int argc, char** argv) {
                    int(pass_end), (unsigned long long)work.taken, (unsigned long long)work.left);
       if (pass_end) std::fflush(progress_log);
     };
-    auto on_tile = [&](const Tile&) {
+    RenderJobEvents events;
+    events.started = [&](bool restored) {
+      resumed = session.seconds();
+      render_start = std::chrono::steady_clock::now();
+      if (restored && !o.quiet)
+        std::fprintf(stderr, "Resuming from %s: %.1f spp a pixel, %.2f s rendered\n", o.checkpoint.c_str(),
+                     session.stats().samples / pixels, session.seconds());
+    };
+    events.tile = [&](const Tile&) {
       const double t = clock(), eta = estimate.remaining_seconds(t);
       const double fraction = estimate.progress(t);
       if (progress_log) log_progress(t, fraction, eta, false);
@@ -184,7 +184,7 @@ int main(int argc, char** argv) {
       const double err = last_error.load();
       bar.update(std::min(0.999, fraction), std::isfinite(err) ? "error " + format_error_estimate(err) : std::string(), eta);
     };
-    auto on_pass = [&](const PassReport& r) {
+    events.pass = [&](const PassReport& r) {
       const double t = clock();
       estimate.update(session, t, r.error);
       last_error = r.error;
@@ -198,13 +198,7 @@ int main(int argc, char** argv) {
       std::fprintf(log, "\n");
       std::fflush(log);
     };
-    while (!driver.done()) {
-      const PassReport r = driver.step(nullptr, on_tile);
-      on_pass(r);
-      if (!r.completed) break;  // the time limit cut the pass: the last checkpoint is the last whole pass
-      if (checkpoints) checkpoints->after_pass(session, driver, driver.done());
-    }
-    const StopReason why = driver.reason();
+    const StopReason why = run_render_job(session, o.limits, checkpoints.get(), nullptr, events);
     bar.finish();
     if (log) std::fclose(log);
     if (progress_log) std::fclose(progress_log);
