@@ -4,6 +4,7 @@
 'use strict';
 
 const JOB_PAGE = 100;  // the server's default page size: the first page is a plain GET /api/jobs
+const PRESS_HOLD_MS = 5000;  // longest a press holds the list back (its release may never come)
 
 // Settings beside the columns that can tell two jobs apart: [field, label as text].
 const OTHER_SETTINGS = [
@@ -35,6 +36,8 @@ const jobList = {
   rows: new Map(),  // id -> <tr>
   pages: 1,         // pages of JOB_PAGE shown; each poll fetches them all again
   more: false,      // the server has older jobs than those shown
+  pressed: 0,       // when a pointer went down on the list; 0: none is down
+  held: null,       // the jobs to render once it is released
 };
 
 function fmtSeconds(s) {
@@ -82,6 +85,14 @@ function hasImage(j) {
 }
 
 function renderJobs(jobs) {
+  // A click is a press and a release on one element: rows moved in between (a job added on top,
+  // columns resized by a job's progress) would send it to the table instead, and the tick or the
+  // button's action would be lost. So the list waits for the release.
+  if (jobList.pressed && performance.now() - jobList.pressed < PRESS_HOLD_MS) {
+    jobList.held = jobs;
+    return;
+  }
+  jobList.held = null;
   const body = $('#job-rows');
   const seen = new Set();
   jobs.forEach((j, i) => {
@@ -250,6 +261,14 @@ function onReconnected() {
 }
 
 function initJobs() {
+  $('#job-rows').addEventListener('pointerdown', () => { jobList.pressed = performance.now(); });
+  const release = (e) => {
+    if (!jobList.pressed || (e.type === 'blur' && e.target !== window)) return;
+    jobList.pressed = 0;
+    // A task later: the click comes in the release's task, and its handlers see the rows it hit.
+    setTimeout(() => { if (jobList.held && !jobList.pressed) renderJobs(jobList.held); });
+  };
+  for (const type of ['pointerup', 'pointercancel', 'blur']) window.addEventListener(type, release, true);
   $('#job-rows').addEventListener('click', (e) => {
     const b = e.target.closest('[data-action]');
     if (!b || b.tagName === 'A' || b.tagName === 'INPUT') return;  // links; compare boxes: compare.js

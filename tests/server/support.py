@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 
+import pytest
 import requests
 from jsonschema import Draft4Validator
 from referencing import Registry, Resource
@@ -31,6 +32,13 @@ CORNELL = SOURCE_DIR / "scenes/cornell.dae"
 # A render that finishes in a few milliseconds and one that runs until cancelled (or time_limit).
 TINY = {"scene": "cornell", "width": 64, "height": 48, "spp": 4, "max_depth": 3, "seed": 1}
 ENDLESS = {"scene": "cornell", "width": 160, "height": 120, "spp": 65536, "adaptive": False, "max_depth": 5}
+
+
+def cannot_run(why):
+    """Our rule: a test that cannot run where CI runs fails under CI=true rather than skipping."""
+    if os.environ.get("CI") == "true":
+        pytest.fail(f"CI=true, yet {why}")
+    pytest.skip(why)
 
 
 # ---- the contract: server/openapi.json as JSON Schema (draft 4, which OpenAPI 3.0 extends) ----
@@ -190,10 +198,11 @@ class Server:
     """`token`: started with --token and its Api sends it; `env`: extra environment; `limit_file_kib`:
     the process may write files of at most that size (ulimit -f: a disk that fills up);
     `limit_memory_mib`: its address space (ulimit -v: memory that runs out); `limit_open_files`: its
-    file descriptors (ulimit -n, soft and hard)."""
+    file descriptors (ulimit -n, soft and hard); `prefix`: a command the server runs under, which
+    must exec it (so that the pid stays the server's), e.g. unshare for namespaces of its own."""
 
     def __init__(self, root, contract, threads=1, args=(), scenes=None, token=None, env=None, limit_file_kib=None,
-                 limit_memory_mib=None, limit_open_files=None, bundled_scenes=False):
+                 limit_memory_mib=None, limit_open_files=None, bundled_scenes=False, prefix=()):
         self.root = Path(root)
         self.token = token
         self.env = env
@@ -206,6 +215,7 @@ class Server:
         self.contract = contract
         self.threads = threads
         self.args = list(args)
+        self.prefix = list(prefix)
         self.proc = None
         if not scenes and not self.scenes.exists():
             self.scenes.mkdir(parents=True)
@@ -227,6 +237,7 @@ class Server:
             limits.append(f"ulimit -n {int(self.limit_open_files)}")
         if limits:  # bash sets the limits, then becomes the server (same pid)
             cmd = ["bash", "-c", " && ".join(limits) + ' && exec "$0" "$@"', *cmd]
+        cmd = [*self.prefix, *cmd]
         env = dict(os.environ, **self.env) if self.env else None
         self.log_path = self.root / f"server-{len(list(self.root.glob('server-*.log'))) + 1}.log"
         self.log = open(self.log_path, "wb")

@@ -1,14 +1,17 @@
 """Disk faults: a disk that fills up while a job writes its image, and a data directory that
 becomes unusable, give a clear error and a failed (or refused) job, never a crash; nothing half
-written is left behind, and the server keeps serving. The full disk is a real tiny tmpfs where
-mounting is allowed (root, not in every container), and always a file-size limit (ulimit -f)."""
+written is left behind, and the server keeps serving. The full disk is a real tiny tmpfs (in a user +
+mount namespace of the server's own, which needs no privilege, else a plain mount), and a file-size
+limit (ulimit -f)."""
+import errno
 import json
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 
-from support import CORNELL, RENDER_SERVER, TINY
+from support import CORNELL, RENDER_SERVER, TINY, cannot_run
 
 BIG = {"scene": "cornell", "width": 200, "height": 150, "spp": 4, "max_depth": 3}  # an EXR of ~200 KB
 
@@ -38,34 +41,44 @@ def test_image_bigger_than_the_file_size_limit_fails_the_job(servers):
 
 
 @pytest.fixture
-def tiny_tmpfs(tmp_path):
-    mnt = tmp_path / "tmpfs"
+def tmpfs_server(servers, tmp_path):
+    """A server whose --data is on a 160 KiB tmpfs; yields it and that tmpfs as this process sees it."""
+    mnt = tmp_path / "disk"  # not the server's own folder (tmp_path / name), where its scenes and log are
     mnt.mkdir()
-    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=160k", "tmpfs", str(mnt)],
-                             capture_output=True).returncode == 0
-    if not mounted:
-        pytest.skip("mounting a tmpfs is not permitted here (the ulimit test covers a full disk)")
-    yield mnt
-    subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+    mount = ["mount", "-t", "tmpfs", "-o", "size=160k", "tmpfs", str(mnt)]
+    # First choice, unprivileged: the server gets a user + mount namespace of its own, mounts there and
+    # execs; the mount is private to it and goes when the server exits, so nothing stays mounted here.
+    own_ns = ["unshare", "-Urm", "sh", "-c", 'mount -t tmpfs -o size=160k tmpfs "$0" && exec "$@"', str(mnt)]
+    plain = False
+    if subprocess.run([*own_ns, "true"], capture_output=True).returncode != 0:
+        plain = subprocess.run(mount, capture_output=True).returncode == 0
+        if not plain:
+            cannot_run("neither mount nor unshare -Urm can make a tmpfs here (the ulimit test covers a full disk)")
+    srv = servers("tmpfs", prefix=[] if plain else own_ns, args=["--data", str(mnt / "data")])  # a later --data wins
+    # Through /proc/PID/root the path resolves in the server's mount namespace, where the tmpfs is.
+    yield srv, Path(f"/proc/{srv.proc.pid}/root") / mnt.relative_to("/")
+    srv.kill()
+    if plain:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
 
 
-def test_full_tmpfs_fails_the_job_with_enospc(servers, tiny_tmpfs):
-    srv = servers("tmpfs", args=["--data", str(tiny_tmpfs / "data")])  # a later --data wins
+def test_full_tmpfs_fails_the_job_with_enospc(tmpfs_server):
+    srv, disk = tmpfs_server
     api = srv.api
     job = api.submit(BIG)
     failed = api.wait(job["id"], ("failed", "done"), timeout=30)
     assert failed["state"] == "failed" and "No space left on device" in failed["message"], failed
     assert srv.alive()
-    no_temp_files(tiny_tmpfs / "data")
+    no_temp_files(disk / "data")
     # Full to the last block: a new job cannot even be stored. Refused with 507, nothing queued.
-    filler = tiny_tmpfs / "filler"
+    filler = disk / "filler"
     try:
         with open(filler, "wb") as f:
             while True:
                 f.write(b"\0" * 4096)
                 f.flush()
-    except OSError:
-        pass  # full
+    except OSError as e:
+        assert e.errno == errno.ENOSPC, e  # full (not a path this process cannot reach)
     resp = api.post("/api/jobs", TINY)
     api.error(resp, 507)
     assert "No space left on device" in resp.json()["error"]["message"]
@@ -77,17 +90,23 @@ def test_full_tmpfs_fails_the_job_with_enospc(servers, tiny_tmpfs):
 def test_data_directory_that_vanishes_refuses_jobs_and_fails_running_ones(servers):
     srv = servers("vanish", threads=1)
     api = srv.api
-    running = api.submit(dict(BIG, spp=65536, adaptive=False, time_limit=1.0))
-    api.wait(running["id"], "running")
+    # No request makes a running job finish on demand (cancel stores a cancelled job's image, limits
+    # cannot change while it renders), so an endless job holds the one render slot while the directory
+    # goes, and the job behind it renders, and stores its image, only after that.
+    endless = api.submit(dict(BIG, spp=65536, adaptive=False))
+    api.wait(endless["id"], "running")
+    job = api.submit(BIG)
+    assert api.job(job["id"])["state"] == "queued"
     # The data directory goes (a disk unmounted, a folder removed) and a file takes its place.
     shutil.rmtree(srv.data / "jobs")
     (srv.data / "jobs").write_text("not a directory")
-    failed = api.wait(running["id"], ("failed", "done"), timeout=30)
-    assert failed["state"] == "failed" and "cannot store the finished image" in failed["message"]
+    assert api.delete(f"/api/jobs/{endless['id']}", expect=200).json()["state"] == "cancelled"
+    failed = api.wait(job["id"], ("failed", "done"), timeout=30)
+    assert failed["state"] == "failed" and "cannot store the finished image" in failed["message"], failed
     resp = api.post("/api/jobs", TINY)
     api.error(resp, 507)
     assert "Not a directory" in resp.json()["error"]["message"]
-    assert [j["id"] for j in api.get("/api/jobs").json()["jobs"]] == [running["id"]]
+    assert [j["id"] for j in api.get("/api/jobs").json()["jobs"]] == [job["id"], endless["id"]]
     assert srv.alive() and api.get("/api/health").json()["status"] == "ok"
 
 

@@ -15,7 +15,7 @@ import pytest
 import requests
 
 from images import decode_png
-from support import CORNELL, ENDLESS, RENDER_SERVER, TINY, RawConnection, raw_request
+from support import CORNELL, ENDLESS, RENDER_SERVER, TINY, RawConnection, cannot_run, raw_request
 
 IEND = b"\x00\x00\x00\x00IEND\xaeB`\x82"
 
@@ -308,16 +308,26 @@ def test_expect_continue_with_an_oversized_body_gets_413_and_no_invitation(serve
 
 @pytest.fixture
 def read_only_mount(tmp_path):
+    """An empty read-only tmpfs; yields (prefix, path): the command the server runs under (it must exec
+    the server) and where the tmpfs is for it."""
     mnt = tmp_path / "ro"
     mnt.mkdir()
-    if subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(mnt)],
-                      capture_output=True).returncode != 0:
-        pytest.skip("mounting a tmpfs is not permitted here")
-    yield mnt
-    subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+    # First choice, unprivileged: the server gets a user + mount namespace of its own, mounts there and
+    # execs; the mount is private to it and goes when the server exits, so nothing stays mounted here.
+    own_ns = ["unshare", "-Urm", "sh", "-c", 'mount -t tmpfs -o ro,size=64k tmpfs "$0" && exec "$@"', str(mnt)]
+    plain = False
+    if subprocess.run([*own_ns, "true"], capture_output=True).returncode != 0:
+        plain = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(mnt)],
+                               capture_output=True).returncode == 0
+        if not plain:
+            cannot_run("neither mount nor unshare -Urm can make a read-only tmpfs here")
+    yield ([] if plain else own_ns), mnt
+    if plain:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
 
 
 def test_a_read_only_data_folder_is_reported_as_read_only(read_only_mount):
-    r = subprocess.run([str(RENDER_SERVER), "--port", "0", "--data", str(read_only_mount / "data")],
+    prefix, mnt = read_only_mount
+    r = subprocess.run([*prefix, str(RENDER_SERVER), "--port", "0", "--data", str(mnt / "data")],
                        capture_output=True, text=True, timeout=30)
     assert r.returncode != 0 and "Read-only file system" in r.stderr, r.stderr

@@ -81,6 +81,24 @@ test("the job list shows each job's settings, and a focus stack's rows differ in
   await page.click('#sweep-close');
 });
 
+// A click is a press and a release on the same element: a refresh between them that moves the rows
+// (here a new job on top) must not lose it.
+test('a click on a row is not lost when the list refreshes while the button is pressed', async () => {
+  const box = `${row(stack[3])} input[data-action="compare"]`;
+  await page.locator(box).scrollIntoViewIfNeeded();
+  const b = await page.locator(box).boundingBox();
+  await page.mouse.move(b.x + b.width / 2, b.y + b.height / 2);
+  await page.mouse.down();
+  const added = await api.post('/api/jobs', { scene: 'cornell', width: 8, height: 8, spp: 1 });
+  assert.equal(added.status, 201);
+  // The second refresh starts after the job was added (the first may have been under way).
+  await page.evaluate(async () => { await refreshJobs(); await refreshJobs(); });
+  await page.mouse.up();
+  assert.equal(await page.isChecked(box), true, 'the press and release on the box did not tick it');
+  await page.waitForSelector(`#job-rows tr:first-child[data-id="${added.data.id}"]`);  // shown once released
+  await page.uncheck(box);
+});
+
 test('pause holds a job (paused badge, no ETA), resume takes it to done; a cancelled job downloads', async () => {
   // A long job A holds the renderer; B waits behind it.
   const a = await submit({ width: 320, height: 240, spp: 4096 });
