@@ -11,6 +11,7 @@
 
 #include "bench_common.h"
 #include "collada.h"
+#include "loop_forms.h"
 #include "progress.h"
 #include "session.h"
 
@@ -28,8 +29,9 @@ enum class Form { specialised, generic, one_path, no_lanes };
 double samples_per_second(const SceneBase& base, RenderParams p, Form form) {
   auto scene = make_view(base, p);
   if (form == Form::generic) scene->features.bits = kFeatAll;
-  if (form == Form::one_path) scene->loop.packets = false;
-  if (form == Form::no_lanes) scene->loop.lanes = false;
+  forms::Scoped forms;
+  forms->packets = form != Form::one_path;
+  forms->lanes = form != Form::no_lanes;
   RenderSession s(*scene, p);
   s.render_all();
   return s.stats().samples / s.stats().seconds;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "accel_math.h"
+#include "loop_forms.h"
 
 namespace pt {
 
@@ -565,7 +566,7 @@ bool Accel::occluded(const Ray& ray) const {
 void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit* hits, uint8_t* found,
                            const uint8_t* camera) const {
   const Impl& a = *m_impl;
-  if (a.packet_width == 16) {
+  if (packet_width() == 16) {
     if (a.attributes) intersect_packets<16, true>(a, rays, stride, n, hits, found, camera);
     else intersect_packets<16, false>(a, rays, stride, n, hits, found, camera);
   } else {
@@ -577,15 +578,10 @@ void Accel::intersect_many(const Ray* rays, size_t stride, size_t n, SurfaceHit*
 bool Accel::has_unlit() const { return m_impl->unlit; }
 
 void Accel::occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const {
-  if (m_impl->packet_width == 16) occluded_packets<16>(*m_impl, rays, n, blocked);
+  if (packet_width() == 16) occluded_packets<16>(*m_impl, rays, n, blocked);
   else occluded_packets<8>(*m_impl, rays, n, blocked);
 }
 
-int Accel::packet_width() const { return m_impl->packet_width; }
-
-void Accel::set_packet_width(int width) {
-  if (width != 8 && width != 16) throw std::invalid_argument("Accel: packet width must be 8 or 16");
-  m_impl->packet_width = width;
-}
+int Accel::packet_width() const { return forms::packet_width() ? forms::packet_width() : m_impl->packet_width; }
 
 }  // namespace pt

@@ -87,9 +87,8 @@ class Accel {
   bool has_unlit() const;
   void occluded_many(const Ray* rays, size_t n, uint8_t* blocked) const;
   // Rays per Embree packet in intersect_many / occluded_many: Embree's native width, 16 on
-  // AVX-512 and 8 below it. set_packet_width (8 or 16) overrides it, for tests.
+  // AVX-512 and 8 below it (loop_forms.h: the test build may take the other).
   int packet_width() const;
-  void set_packet_width(int width);
   // Bytes held for rendering: everything Embree allocated (BVH, vertex and index buffers, as its
   // memory monitor reports) plus our per-triangle shading data.
   size_t memory_bytes() const;

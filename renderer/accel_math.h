@@ -1,7 +1,8 @@
 // The ray tests and hit refinement Accel runs around Embree, in plain maths (no Embree types, so
-// that tests can check them directly): Embree's input range, the scene-bounds slab test, the
-// analytic sphere and the hit records of triangles and spheres, each with an SSE form that gives
-// the scalar form's bits.
+// that tests can check them directly against scalar references): Embree's input range, the
+// scene-bounds slab test and the hit records of triangles and spheres in SSE (x86-64's baseline,
+// as lane_math.h assumes), and the analytic sphere in the lane vocabulary at widths 1 and 4
+// (sphere_hit.inc).
 #pragma once
 
 #include <cmath>
@@ -9,11 +10,10 @@
 #include <cstring>
 #include <utility>
 
-#if defined(__SSE2__)
 #include <emmintrin.h>
-#endif
 
 #include "accel.h"
+#include "lane_math.h"
 #include "math.h"
 
 namespace pt {
@@ -24,7 +24,6 @@ namespace pt {
 // they are treated as misses instead. Found by the scene fuzzer (tests/fuzz-regressions).
 inline bool embree_accepts(const Ray& r) {
   constexpr float kLarge = 1.844e18f;
-#if defined(__SSE2__)
   // Both halves of the ray at once: |o.x o.y o.z d.x| and |d.y d.z tmin tmax| against the limit
   // (infinity for tmin and tmax, which only have to be numbers). A NaN fails every compare.
   static_assert(sizeof(Ray) == 8 * sizeof(float), "Ray is o, d, tmin, tmax without padding");
@@ -34,11 +33,6 @@ inline bool embree_accepts(const Ray& r) {
   const __m128 ok = _mm_and_ps(_mm_cmple_ps(lo, _mm_set1_ps(kLarge)),
                                _mm_cmple_ps(hi, _mm_setr_ps(kLarge, kLarge, INFINITY, INFINITY)));
   return _mm_movemask_ps(ok) == 0xF;
-#else
-  return std::fabs(r.o.x) <= kLarge && std::fabs(r.o.y) <= kLarge && std::fabs(r.o.z) <= kLarge &&
-         std::fabs(r.d.x) <= kLarge && std::fabs(r.d.y) <= kLarge && std::fabs(r.d.z) <= kLarge &&
-         !std::isnan(r.tmin) && !std::isnan(r.tmax);
-#endif
 }
 
 // Slab test (Kay & Kajiya, "Ray tracing complex scenes", SIGGRAPH 1986) of the ray's segment
@@ -50,7 +44,6 @@ inline bool may_hit_bounds(const Ray& r, const float lo[4], const float hi[4]) {
   // SSE's maxps and minps are these exact expressions.
   auto mx = [](float a, float b) { return a > b ? a : b; };
   auto mn = [](float a, float b) { return a < b ? a : b; };
-#if defined(__SSE2__)
   const float* f = reinterpret_cast<const float*>(&r);
   const __m128 o = _mm_loadu_ps(f), l = _mm_loadu_ps(lo), h = _mm_loadu_ps(hi);  // lane 3: d.x within (-inf, inf)
   if (_mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(o, l), _mm_cmple_ps(o, h))) == 0xF) return true;
@@ -61,50 +54,21 @@ inline bool may_hit_bounds(const Ray& r, const float lo[4], const float hi[4]) {
   _mm_store_ps(far, _mm_max_ps(a, b));
   const float t0 = mx(mx(mx(r.tmin, near[0]), near[1]), near[2]);
   const float t1 = mn(mn(mn(r.tmax, far[0]), far[1]), far[2]);
-#else
-  if (r.o.x >= lo[0] && r.o.x <= hi[0] && r.o.y >= lo[1] && r.o.y <= hi[1] && r.o.z >= lo[2] && r.o.z <= hi[2])
-    return true;
-  const float ix = 1.0f / r.d.x, iy = 1.0f / r.d.y, iz = 1.0f / r.d.z;
-  const float ax = (lo[0] - r.o.x) * ix, bx = (hi[0] - r.o.x) * ix;
-  const float ay = (lo[1] - r.o.y) * iy, by = (hi[1] - r.o.y) * iy;
-  const float az = (lo[2] - r.o.z) * iz, bz = (hi[2] - r.o.z) * iz;
-  const float t0 = mx(mx(mx(r.tmin, mn(ax, bx)), mn(ay, by)), mn(az, bz));
-  const float t1 = mn(mn(mn(r.tmax, mx(ax, bx)), mx(ay, by)), mx(az, bz));
-#endif
   return !(t0 > t1);
 }
 
-// Spheres are Embree user geometry with this analytic test, not RTC_GEOMETRY_TYPE_SPHERE_POINT:
-// Embree's sphere points are built for many small spheres (point clouds), and on the course's few
-// large spheres they cost more than a scalar quadratic. The roots follow Haines et al., "Precision
-// Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7 (2019): the discriminant from
-// the distance of the centre to the ray line, and the smaller root from c / q, which avoid the
-// cancellation of the textbook formula far from the sphere and for rays that graze it.
-// s: centre x y z and radius.
-inline bool sphere_roots(const float* s, float ox, float oy, float oz, float dx, float dy, float dz, float& t0,
-                         float& t1) {
-  float fx = ox - s[0], fy = oy - s[1], fz = oz - s[2], r = s[3];
-  float a = dx * dx + dy * dy + dz * dz;
-  float b = -(fx * dx + fy * dy + fz * dz);  // b' = -f.d
-  float k = b / a;
-  float lx = fx + k * dx, ly = fy + k * dy, lz = fz + k * dz;  // centre-to-line offset
-  float disc = a * (r * r - (lx * lx + ly * ly + lz * lz));
-  if (!(disc >= 0) || !(a > 0)) return false;
-  float c = fx * fx + fy * fy + fz * fz - r * r;
-  float q = b + std::copysign(std::sqrt(disc), b);
-  t0 = q != 0 ? c / q : 0;
-  t1 = q / a;
-  if (t0 > t1) std::swap(t0, t1);
-  return true;
-}
+// The analytic sphere test (sphere_hit.inc) at width 1 and at width 4.
+namespace lane1 {
+#include "sphere_hit.inc"
+}  // namespace lane1
+namespace lane4 {
+#include "sphere_hit.inc"
+}  // namespace lane4
 
-// The nearest root of sphere_roots inside (tnear, tfar), if any.
+// The nearest root inside (tnear, tfar) of sphere s (centre x y z, radius) along o + t d, if any.
 inline bool sphere_hit(const float* s, float ox, float oy, float oz, float dx, float dy, float dz, float tnear,
                        float tfar, float& t) {
-  float t0, t1;
-  if (!sphere_roots(s, ox, oy, oz, dx, dy, dz, t0, t1)) return false;
-  t = t0 > tnear ? t0 : t1;
-  return t > tnear && t < tfar;
+  return lane1::sphere_hit(s, true, Vec3(ox, oy, oz), Vec3(dx, dy, dz), tnear, tfar, t);
 }
 
 // Four rays in SoA layout (each pointer at four consecutive lanes, as in Embree's packets).
@@ -113,48 +77,17 @@ struct RayLanes4 {
   const int* valid;  // -1: a lane to test
 };
 
-// sphere_hit for four rays at once: the same operations in the same order, so the same bits.
-// Returns the mask of valid lanes with a hit (bit k: lane k), and their t in t[k].
+// sphere_hit for four rays at once: the same text, so the same bits. Returns the mask of valid
+// lanes with a hit (bit k: lane k), and their t in t[k].
 inline int sphere_hit4(const float* s, const RayLanes4& r, float t[4]) {
-#if defined(__SSE2__)
-  const __m128 valid = _mm_castsi128_ps(
-      _mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(r.valid)), _mm_set1_epi32(-1)));
-  if (_mm_movemask_ps(valid) == 0) return 0;
-  const __m128 dx = _mm_loadu_ps(r.dx), dy = _mm_loadu_ps(r.dy), dz = _mm_loadu_ps(r.dz);
-  const __m128 fx = _mm_sub_ps(_mm_loadu_ps(r.ox), _mm_set1_ps(s[0]));
-  const __m128 fy = _mm_sub_ps(_mm_loadu_ps(r.oy), _mm_set1_ps(s[1]));
-  const __m128 fz = _mm_sub_ps(_mm_loadu_ps(r.oz), _mm_set1_ps(s[2]));
-  const __m128 radius = _mm_set1_ps(s[3]), rr = _mm_mul_ps(radius, radius), zero = _mm_setzero_ps();
-  const __m128 sign = _mm_set1_ps(-0.0f);
-  auto dot = [](__m128 ax, __m128 ay, __m128 az, __m128 bx, __m128 by, __m128 bz) {
-    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz));
-  };
-  const __m128 a = dot(dx, dy, dz, dx, dy, dz);
-  const __m128 b = _mm_xor_ps(dot(fx, fy, fz, dx, dy, dz), sign);
-  const __m128 k = _mm_div_ps(b, a);
-  const __m128 lx = _mm_add_ps(fx, _mm_mul_ps(k, dx)), ly = _mm_add_ps(fy, _mm_mul_ps(k, dy)),
-               lz = _mm_add_ps(fz, _mm_mul_ps(k, dz));
-  const __m128 disc = _mm_mul_ps(a, _mm_sub_ps(rr, dot(lx, ly, lz, lx, ly, lz)));
-  __m128 ok = _mm_and_ps(valid, _mm_and_ps(_mm_cmpge_ps(disc, zero), _mm_cmpgt_ps(a, zero)));
-  if (_mm_movemask_ps(ok) == 0) return 0;
-  const __m128 c = _mm_sub_ps(dot(fx, fy, fz, fx, fy, fz), rr);
-  const __m128 q = _mm_add_ps(b, _mm_or_ps(_mm_sqrt_ps(disc), _mm_and_ps(b, sign)));  // b + copysign(sqrt, b)
-  const __m128 t0q = _mm_and_ps(_mm_div_ps(c, q), _mm_cmpneq_ps(q, zero));         // q != 0 ? c / q : 0
-  const __m128 t1q = _mm_div_ps(q, a);
-  const __m128 t0 = _mm_min_ps(t1q, t0q), t1 = _mm_max_ps(t0q, t1q);  // if (t0 > t1) swap
-  const __m128 tnear = _mm_loadu_ps(r.tnear), tfar = _mm_loadu_ps(r.tfar);
-  const __m128 first = _mm_cmpgt_ps(t0, tnear);
-  const __m128 th = _mm_or_ps(_mm_and_ps(first, t0), _mm_andnot_ps(first, t1));  // t0 > tnear ? t0 : t1
-  ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(th, tnear), _mm_cmplt_ps(th, tfar)));
-  _mm_storeu_ps(t, th);
-  return _mm_movemask_ps(ok);
-#else
-  int mask = 0;
-  for (int k = 0; k < 4; ++k)
-    if (r.valid[k] == -1 && sphere_hit(s, r.ox[k], r.oy[k], r.oz[k], r.dx[k], r.dy[k], r.dz[k], r.tnear[k], r.tfar[k], t[k]))
-      mask |= 1 << k;
-  return mask;
-#endif
+  using namespace lane4;
+  I valid;
+  std::memcpy(&valid, r.valid, sizeof valid);  // Embree's lanes: -1 to test, 0 not
+  F th;
+  const M hit = lane4::sphere_hit(s, valid == -1, {loadu(r.ox), loadu(r.oy), loadu(r.oz)},
+                                  {loadu(r.dx), loadu(r.dy), loadu(r.dz)}, loadu(r.tnear), loadu(r.tfar), th);
+  std::memcpy(t, &th, sizeof th);
+  return lane4::bits(hit);
 }
 
 // What a hit on a triangle needs besides its vertices, in one record so that one cache line
@@ -187,52 +120,6 @@ inline void note_attributes(const TriangleData& m, unsigned prim, float u, float
   hit.bv = v;
 }
 
-// The hit record of a hit on triangle `prim` at t with barycentrics (u, v): the point from the
-// barycentrics (not o + t d, which drifts off the plane), the unit face normal (for a degenerate
-// triangle, from `eng()`: Embree's unnormalised one), the interpolated shading normal, material, light.
-// `Attributes`: the scene has meshes with uvs or colours (false skips even the check).
-template <bool Attributes = true, class EmbreeNormal>
-inline void refine_triangle_scalar(const TriangleData& m, unsigned prim, float t, float u, float v, EmbreeNormal&& eng,
-                                   SurfaceHit& hit) {
-  (void)t;  // the point comes from the barycentrics
-  const uint32_t* tri = m.indices + 3 * size_t(prim);
-  const TriangleInfo& info = m.tris[prim];
-  auto at = [&](const float* base, uint32_t i) { return Vec3(base[3 * size_t(i)], base[3 * size_t(i) + 1], base[3 * size_t(i) + 2]); };
-  const float w = 1 - u - v;
-  hit.p = at(m.positions, tri[0]) * w + at(m.positions, tri[1]) * u + at(m.positions, tri[2]) * v;
-  Vec3 ng = info.ng;
-  if (is_black(ng)) {
-    ng = normalize(eng());
-    if (is_black(ng)) ng = Vec3(0, 1, 0);
-  }
-  hit.ng = ng;
-  hit.ns = ng;
-  if (m.normals) {
-    Vec3 ns = normalize(at(m.normals, tri[0]) * w + at(m.normals, tri[1]) * u + at(m.normals, tri[2]) * v);
-    if (!is_black(ns)) hit.ns = ns;
-  }
-  hit.material = info.material;
-  hit.light = info.light;
-  hit.offset = 0;
-  if (Attributes && m.attributes) note_attributes(m, prim, u, v, hit);
-}
-
-// The hit record of a hit on sphere s (centre x y z, radius) at t: the point re-projected onto the
-// sphere, which removes the error of o + t d, and the outward normal.
-inline void refine_sphere_scalar(const float* s, int material, const Ray& ray, float t, SurfaceHit& hit) {
-  const Vec3 c(s[0], s[1], s[2]);
-  const float r = s[3];
-  Vec3 n = normalize(ray.o + ray.d * t - c);
-  if (is_black(n)) n = Vec3(0, 1, 0);
-  hit.p = c + n * r;
-  hit.ng = hit.ns = n;
-  hit.material = material;
-  hit.light = -1;
-  // Embree's sphere test loses ~ulp(r)/cos near the surface; push far enough to clear it.
-  hit.offset = 1e-5f * r;
-}
-
-#if defined(__SSE2__)
 namespace sse {
 
 // normalize() of lanes x y z, with its operations in its order: the same bits (lane 3 is zero or
@@ -267,14 +154,17 @@ static_assert(offsetof(SurfaceHit, ng) == offsetof(SurfaceHit, p) + 12 &&
 }
 
 }  // namespace sse
-#endif
 
-// refine_triangle_scalar's record with SSE: its bits, in about half the instructions (the hit
-// loop's refinement was a tenth of a mesh scene's pass; docs/performance.md, "Design choices that pay").
+// The hit record of a hit on triangle `prim` at t with barycentrics (u, v): the point from the
+// barycentrics (not o + t d, which drifts off the plane), the unit face normal (for a degenerate
+// triangle, from `eng()`: Embree's unnormalised one), the interpolated shading normal, material,
+// light. `Attributes`: the scene has meshes with uvs or colours (false skips even the check). In
+// SSE, three floats a register: half the instructions of the scalar form, with its bits (the hit
+// loop's refinement was a tenth of a mesh scene's pass; docs/performance.md, "Design choices that
+// pay"; tests/test_accel_math.cpp keeps the scalar form as the reference).
 template <bool Attributes = true, class EmbreeNormal>
 [[gnu::always_inline]] inline void refine_triangle(const TriangleData& m, unsigned prim, float t, float u, float v,
                                                    EmbreeNormal&& eng, SurfaceHit& hit) {
-#if defined(__SSE2__)
   (void)t;  // the point comes from the barycentrics
   const uint32_t* tri = m.indices + 3 * size_t(prim);
   const TriangleInfo& info = m.tris[prim];
@@ -295,15 +185,13 @@ template <bool Attributes = true, class EmbreeNormal>
   std::memcpy(&hit.material, &info.material, 2 * sizeof(int));  // material and light, adjacent in both
   hit.offset = 0;
   if (Attributes && m.attributes) note_attributes(m, prim, u, v, hit);
-#else
-  refine_triangle_scalar<Attributes>(m, prim, t, u, v, eng, hit);
-#endif
 }
 
-// refine_sphere_scalar's record with SSE: its bits.
+// The hit record of a hit on sphere s (centre x y z, radius) at t: the point re-projected onto the
+// sphere, which removes the error of o + t d, and the outward normal. In SSE, with the scalar
+// form's bits (tests/test_accel_math.cpp).
 [[gnu::always_inline]] inline void refine_sphere(const float* s, int material, const Ray& ray, float t,
                                                  SurfaceHit& hit) {
-#if defined(__SSE2__)
   static_assert(sizeof(Ray) == 8 * sizeof(float), "Ray is o, d, tmin, tmax without padding");
   const __m128 sphere = _mm_loadu_ps(s);  // centre, radius
   const __m128 o = _mm_loadu_ps(&ray.o.x), d = _mm_loadu_ps(&ray.d.x);
@@ -313,10 +201,8 @@ template <bool Attributes = true, class EmbreeNormal>
   sse::store_vectors(hit, _mm_add_ps(sphere, _mm_mul_ps(n, _mm_set1_ps(r))), n, n);
   hit.material = material;
   hit.light = -1;
+  // The sphere test loses ~ulp(r)/cos near the surface; push far enough to clear it.
   hit.offset = 1e-5f * r;
-#else
-  refine_sphere_scalar(s, material, ray, t, hit);
-#endif
 }
 
 // A uniform number in [0, 1) from a ray and a triangle: the same ray meets the same triangle with

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "lane_math.h"
+#include "loop_forms.h"
 #include "sampling.h"
 
 // Camera rays at every width (camera_rays.inc): one at a time, four in SSE2, eight in AVX2.
@@ -211,10 +212,10 @@ void Camera::pinhole_ray(float sx, float sy, Ray& r) const {
 
 namespace {
 
-// Rays for sensor points i < n: eight at a time in AVX2 where simd::use_avx2(), then four in
+// Rays for sensor points i < n: eight at a time in AVX2 where forms::use_avx2(), then four in
 // SSE2, the tail one by one. A null lens_u makes pinhole rays.
 void camera_rays(const Camera& c, const float* sx, const float* sy, const Vec2* lens_u, size_t n, Ray* out) {
-  size_t i = simd::use_avx2() ? lane8::camera_rays(c, sx, sy, lens_u, n, out) : 0;
+  size_t i = forms::use_avx2() ? lane8::camera_rays(c, sx, sy, lens_u, n, out) : 0;
   i += lane4::camera_rays(c, sx + i, sy + i, lens_u ? lens_u + i : nullptr, n - i, out + i);
   lane1::camera_rays(c, sx + i, sy + i, lens_u ? lens_u + i : nullptr, n - i, out + i);
 }

@@ -54,7 +54,7 @@ struct Camera {
   Ray pinhole_ray(float sx, float sy) const;
   void pinhole_ray(float sx, float sy, Ray& r) const;
   // pinhole_ray for sensor points (sx[i], sy[i]), i < n, in lanes (the same bits): eight at a
-  // time in AVX2 where simd::use_avx2(), then four in SSE2, the tail one by one.
+  // time in AVX2 where forms::use_avx2(), then four in SSE2, the tail one by one.
   void pinhole_rays(const float* sx, const float* sy, size_t n, Ray* out) const;
   // generate_ray for sensor points (sx[i], sy[i]) and lens samples lens_u[i], i < n, in lanes as
   // pinhole_rays (the same bits). Any camera: a pinhole's rays ignore lens_u.

@@ -5,7 +5,10 @@
 #include <cmath>
 
 #include "accel.h"
+#include "lane_math.h"
+#include "loop_forms.h"
 #include "materials.h"
+#include "path_settings.h"
 #include "render_scene.h"
 #include "sampler.h"
 
@@ -16,8 +19,6 @@ namespace {
 // Light paths use the sample streams of pixels no film has (the Sobol index is 32 bits; the
 // high bits of the path index pick the pseudo-pixel).
 constexpr uint64_t kLightPathPixel = 0xC0FFEE0000000000ull;
-// From this many delta bounces on, light paths play Russian roulette (as camera paths do).
-constexpr int kRouletteStart = 5;
 
 // Uniform sampling of the cone of directions from p that can reach a sphere (PBRT 3rd ed.,
 // 13.6.4 "Sampling a cone"); a point inside the sphere sees the whole sphere of directions.
@@ -233,8 +234,8 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
   lp.throughput *= bs.weight * correction;
   lp.beta *= bs.weight * correction;
   if (is_black(lp.beta) || !is_finite(lp.beta)) return false;
-  if (vertex >= kRouletteStart) {
-    float q = std::min(0.95f, max_component(lp.throughput));
+  if (vertex >= kRouletteStart) {  // the camera paths' roulette, on the path's relative throughput
+    const float q = lane1::roulette_probability(lp.throughput);
     if (rng.next_float() >= q) return false;
     lp.beta /= q;
     lp.throughput /= q;
@@ -248,7 +249,7 @@ bool light_path_step(const RenderScene& scene, const RenderParams& params, const
 void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, const CausticFilm& film,
                          uint64_t first, uint64_t count, std::vector<CausticSplat>& out, uint64_t& rays) {
   // A pool of paths advances a vertex at a time, their rays traced together (Embree packets
-  // unless LoopForms::packets is off), then their camera connections. Splats are kept in path order, as
+  // unless forms::packets is off), then their camera connections. Splats are kept in path order, as
   // one path after another would make them, so the image does not depend on the pool.
   constexpr size_t kSlots = 256;
   struct Pending {
@@ -273,7 +274,7 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
     const size_t m = paths.size();
     if (m == 0) break;
     rays += m;
-    if (scene.loop.packets) {  // the rays where they lie in the paths, not copied out
+    if (forms::packets()) {  // the rays where they lie in the paths, not copied out
       scene.accel->intersect_many(&paths[0].ray, sizeof(LightPath), m, hits.data(), found.data());
     } else {
       for (size_t i = 0; i < m; ++i) found[i] = scene.accel->intersect(paths[i].ray, hits[i]);
@@ -295,7 +296,7 @@ void trace_caustic_paths(const RenderScene& scene, const RenderParams& params, c
     paths.erase(paths.begin() + ptrdiff_t(live), paths.end());
     blocked.resize(shadows.size());
     rays += shadows.size();
-    if (scene.loop.packets) {
+    if (forms::packets()) {
       scene.accel->occluded_many(shadows.data(), shadows.size(), blocked.data());
     } else {
       for (size_t k = 0; k < shadows.size(); ++k) blocked[k] = scene.accel->occluded(shadows[k]);

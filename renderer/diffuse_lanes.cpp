@@ -4,6 +4,7 @@
 #include "diffuse_lanes.h"
 
 #include "lane_math.h"
+#include "loop_forms.h"
 
 // SSE2: four lanes, the portable build.
 namespace pt::lane4 {
@@ -21,7 +22,7 @@ PT_END_AVX2
 
 namespace pt::lanes {
 
-using simd::use_avx2;
+using forms::use_avx2;
 
 int lane_width() { return use_avx2() ? 8 : 4; }
 

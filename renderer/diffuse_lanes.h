@@ -2,10 +2,10 @@
 // emissive meshes), then a cosine-weighted bounce. One text (diffuse_lanes_body.inc) in the
 // vocabulary of lane_math.h, built on lane_physics.inc's functions (Frame, face_viewer,
 // sample_area_light, diffuse_*, power_heuristic, russian_roulette, spawn_origin), compiled at
-// three widths: 1 (path_step's vertex, one path at a time), 4 in SSE2 lanes and 8 in AVX2 lanes
-// where the CPU has it (the pool's vertices, path_pool.cpp). Every width computes the same bits,
-// and those of path_step's generic vertex (test_packets.cpp). The pool gathers its diffuse
-// vertices into these arrays, runs the lanes, and scatters the results back.
+// two widths: 4 in SSE2 lanes and 8 in AVX2 lanes where the CPU has it (the pool's vertices,
+// path_pool.cpp). Both compute the bits of path_step's generic vertex, which the path-by-path loop
+// runs (test_packets.cpp). The pool gathers its diffuse vertices into these arrays, runs the
+// lanes, and scatters the results back.
 #pragma once
 
 #include <cstdint>
@@ -17,8 +17,6 @@ namespace pt::lanes {
 constexpr int kMaxLanes = 256;  // the pool's slots
 
 // Structure of arrays, one entry per vertex; the count is padded to a multiple of 8 by the caller.
-// N = 1 is the scalar path_step's vertex (width 1, lane_math.h's lane1), which the compiler keeps in
-// registers.
 template <int N>
 struct DiffuseVerticesN {
   // In: the hit, the arriving ray's direction, the path's throughput and its random numbers.
@@ -57,7 +55,7 @@ void light_pass(DiffuseVertices& v, int n, const Light& light, int samples);
 // The cosine-weighted bounce, throughput update and Russian roulette for vertices [0, n).
 void bounce_pass(DiffuseVertices& v, int n);
 
-// The lanes' width: 8 where the CPU has AVX2 (and simd::allow_avx2 allows it), else 4.
+// The lanes' width: 8 where the CPU has AVX2 (forms::use_avx2, loop_forms.h), else 4.
 int lane_width();
 
 }  // namespace pt::lanes

@@ -7,7 +7,7 @@
 //
 //   lane1  width 1: float, int32_t, bool, Vec2, Vec3 (the scalar code: pt::Frame is lane1::Frame)
 //   lane4  width 4: GCC vectors in SSE2, the portable build
-//   lane8  width 8: GCC vectors in AVX2, for code that runs after simd::use_avx2()
+//   lane8  width 8: GCC vectors in AVX2, for code that runs after forms::use_avx2()
 //
 // Each physics function is thus written once and compiled three times: the scalar path calls
 // lane1's, the lanes lane4's or lane8's, and every lane computes the scalar bits (the vector
@@ -67,6 +67,7 @@ PT_LANE float as_float(int32_t i) {
   std::memcpy(&a, &i, 4);
   return a;
 }
+PT_LANE bool any(bool m) { return m; }
 PT_LANE float sqrt(float a) { return std::sqrt(a); }
 // int32_t(a) as cvttss2si computes it, defined for NaN and out-of-range values too (INT32_MIN, as
 // the vector lanes' cvttps2dq), where the C++ conversion is undefined behaviour.

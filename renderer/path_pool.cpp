@@ -1,10 +1,11 @@
-// The path loop many paths at once (integrator.h's PathBatchTracer): a pool of camera paths whose
+// The path loop many paths at once (integrator.h's PathTracer): a pool of camera paths whose
 // rays go to Embree in packets, their diffuse vertices in SIMD lanes (diffuse_lanes.h), the rest
 // through path_vertex.h's path_step one slot at a time.
 #include "integrator.h"
 
 #include <memory>
 
+#include "diffuse_lanes.h"
 #include "path_vertex.h"
 
 namespace pt {
@@ -34,6 +35,14 @@ struct ShadowBatch {
   }
 };
 
+// Slot i's shadow ray out of the lanes' light_pass, written into r (as spawn_ray_to ends it).
+void lane_shadow_ray(const lanes::DiffuseVertices& v, int i, Ray& r) {
+  r.o = Vec3(v.sox[i], v.soy[i], v.soz[i]);
+  r.d = Vec3(v.sdx[i], v.sdy[i], v.sdz[i]);
+  r.tmin = 0;
+  r.tmax = kShadowRayEnd;
+}
+
 // path_step for the pool's slots which[0, n), all of them at a diffuse hit with depth left, in lanes
 // (diffuse_lanes.h): the draws in path_step's order (light samples, the unused lobe number, the bounce,
 // roulette), light passes light by light, the bounce. The same bits as path_step.
@@ -51,9 +60,9 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
   // The draws of path_step's order (light samples, the BSDF's component pick, the bounce), taken
   // for all vertices at once: each sampler still sees its own draws in that order.
   for (size_t l = 0; l < nl; ++l)  // light sample l of every vertex: u_light[l n, (l + 1) n)
-    Sampler::next_2d_many(samplers.data(), size_t(n), u_light.data() + l * size_t(n), scene.loop.lanes);
+    Sampler::next_2d_many(samplers.data(), size_t(n), u_light.data() + l * size_t(n));
   for (Sampler* rng : samplers) rng->skip_1d();
-  Sampler::next_2d_many(samplers.data(), size_t(n), u.data(), scene.loop.lanes);
+  Sampler::next_2d_many(samplers.data(), size_t(n), u.data());
   for (int j = 0; j < padded; ++j) {
     const uint32_t i = which[j < n ? j : 0];  // padding lanes repeat the first vertex
     PathState& st = slots[i].st;
@@ -188,10 +197,7 @@ void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const
           s.contribution = contribution;
         }
       } shadow{shadows, uint32_t(i)};
-      // Diffuse vertices with depth left went to the lanes above: path_step's own width-1 route
-      // for them is left out of this loop (`false`), and with it its code.
-      alive[i] = path_step<F>(scene, settings, slots[i].st, found[i] != 0, hits[i], rngs[slots[i].job], rays, shadow,
-                              false);
+      alive[i] = path_step<F>(scene, settings, slots[i].st, found[i] != 0, hits[i], rngs[slots[i].job], rays, shadow);
     }
     if (n_lanes)
       diffuse_in_lanes(scene, settings, *lane_data, in_lanes.data(), int(n_lanes), slots, rngs, hits.data(), alive.data(),
@@ -227,10 +233,10 @@ void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const
 
 // Textured scenes take the generic loop rather than eight more instantiations of each loop (build
 // time, code size); they pay its run-time checks of the material kinds they lack.
-PathBatchTracer path_batch_tracer_for(uint32_t bits, const PathSettings& settings) {
+PathTracer path_batch_tracer_for(uint32_t bits, const PathSettings& settings) {
   if (settings.hemisphere) return nullptr;  // -H casts its direct-light rays one at a time
   if (bits & kFeatTexture) return trace_paths_t<kFeatAll>;
-  static const PathBatchTracer table[] = {
+  static const PathTracer table[] = {
       trace_paths_t<0>, trace_paths_t<1>, trace_paths_t<2>, trace_paths_t<3>,
       trace_paths_t<4>, trace_paths_t<5>, trace_paths_t<6>, trace_paths_t<7>,
   };

@@ -6,6 +6,11 @@
 
 namespace pt {
 
+// Russian roulette starts at bounce 5, as Mitsuba 3's path integrator does (rr_depth = 5), on camera
+// paths and light paths (caustics.cpp) alike; why not 3: docs/performance.md, "Russian roulette
+// from bounce 5".
+constexpr int kRouletteStart = 5;
+
 // What the path loop reads of the render options, and the session's choice of who renders the
 // caustic paths: a small value the loop's every form takes instead of all of RenderParams.
 struct PathSettings {

@@ -8,23 +8,13 @@
 // MIS: Veach 1997 ch. 9, power heuristic, light sampling taking `light_samples` samples.
 #pragma once
 
-#include "diffuse_lanes.h"
+#include "lane_math.h"
 #include "path_settings.h"
 #include "render_scene.h"
 #include "materials.h"
 #include "sampler.h"
 
-// The diffuse vertex under area lights at width 1: the text the pool's lanes run at widths 4 and 8.
-namespace pt::lane1 {
-using lanes::DiffuseVerticesN;
-#include "diffuse_lanes_body.inc"
-}  // namespace pt::lane1
-
 namespace pt::path_loop {
-
-// Russian roulette starts at bounce 5, as Mitsuba 3's path integrator does (rr_depth = 5); why
-// not 3: docs/performance.md, "Russian roulette from bounce 5".
-constexpr int kRouletteStart = 5;
 
 // BSDF dispatch reduced to the material kinds the scene has (feature bits, render_scene.h): a scene
 // without microfacet or delta materials calls the inline Lambertian lobe directly.
@@ -181,73 +171,14 @@ struct PathState {
   }
 };
 
-// Slot i's shadow ray out of the lanes' light_pass, written into r (as spawn_ray_to ends it).
-template <int N>
-inline void lane_shadow_ray(const lanes::DiffuseVerticesN<N>& v, int i, Ray& r) {
-  r.o = Vec3(v.sox[i], v.soy[i], v.soz[i]);
-  r.d = Vec3(v.sdx[i], v.sdy[i], v.sdz[i]);
-  r.tmin = 0;
-  r.tmax = kShadowRayEnd;
-}
-
-// path_step's diffuse vertex under area lights (diffuse_lanes_apply): diffuse_lanes_body.inc at
-// width 1, the text the pool's lanes run four or eight at a time (diffuse_in_lanes). The draws in
-// that order: every light sample, the unused lobe number, the bounce, roulette. `bounce` is the
-// vertex's, and `material` the one at the hit (textures applied).
-template <class ShadowSink>
-bool diffuse_vertex(const RenderScene& scene, const PathSettings& settings, PathState& st, int bounce,
-                    const SurfaceHit& hit, const Material& material, Sampler& rng, uint64_t& rays, ShadowSink& shadow) {
-  lanes::DiffuseVerticesN<1> v;
-  v.px[0] = hit.p.x, v.py[0] = hit.p.y, v.pz[0] = hit.p.z;
-  v.gx[0] = hit.ng.x, v.gy[0] = hit.ng.y, v.gz[0] = hit.ng.z;
-  v.nx[0] = hit.ns.x, v.ny[0] = hit.ns.y, v.nz[0] = hit.ns.z;
-  v.offset[0] = hit.offset;
-  v.ax[0] = material.albedo.x, v.ay[0] = material.albedo.y, v.az[0] = material.albedo.z;
-  v.dx[0] = st.ray.d.x, v.dy[0] = st.ray.d.y, v.dz[0] = st.ray.d.z;
-  v.bx[0] = st.beta.x, v.by[0] = st.beta.y, v.bz[0] = st.beta.z;
-  st.start_diffuse_vertex();
-  for (const Light& light : scene.lights) {
-    for (int k = 0; k < settings.light_samples; ++k) {
-      const Vec2 u = rng.next_2d();
-      if (is_black(light.color)) continue;
-      v.ulx[0] = u.x, v.uly[0] = u.y;
-      if (light.kind == LightKind::mesh) {
-        Vec3 q, normal;
-        sample_area_light_point(light, u, q, normal);
-        normal = facing_normal(light, normal, hit.p - q);
-        v.qx[0] = q.x, v.qy[0] = q.y, v.qz[0] = q.z;
-        v.lx[0] = normal.x, v.ly[0] = normal.y, v.lz[0] = normal.z;
-      }
-      lane1::light_pass(v, 1, light, settings.light_samples);
-      if (!v.shadow[0]) continue;
-      ++rays;
-      lane_shadow_ray(v, 0, shadow.ray());
-      shadow.add(Vec3(v.cx[0], v.cy[0], v.cz[0]));
-    }
-  }
-  rng.skip_1d();
-  const Vec2 u = rng.next_2d();
-  v.ubx[0] = u.x, v.uby[0] = u.y;
-  v.roulette[0] = bounce >= kRouletteStart;
-  v.urr[0] = v.roulette[0] ? rng.next_float() : 0.0f;
-  lane1::bounce_pass(v, 1);
-  if (!v.alive[0]) return false;
-  st.beta = Vec3(v.bx[0], v.by[0], v.bz[0]);
-  st.took_diffuse_bounce(bounce, v.pdf[0], hit.p);
-  st.ray.o = Vec3(v.ox[0], v.oy[0], v.oz[0]);
-  st.ray.d = Vec3(v.wx[0], v.wy[0], v.wz[0]);
-  st.ray.tmin = 0;
-  st.ray.tmax = kInf;
-  return true;
-}
-
 // What one path does with the answer to its ray query: emission, light sampling (shadow rays go to
 // `shadow`), the BSDF bounce and Russian roulette. Returns false when the path ends; otherwise
 // st.ray is the next ray. The scalar loop and the batched one both run it, so they trace the same
-// paths from the same random numbers. `diffuse_lit`: diffuse_lanes_apply to the scene.
+// paths from the same random numbers. (The pool takes diffuse vertices under area lights to its
+// SIMD lanes instead, whose bits are this vertex's: diffuse_lanes.h.)
 template <uint32_t F, class ShadowSink>
 bool path_step(const RenderScene& scene, const PathSettings& settings, PathState& st, bool found, const SurfaceHit& hit,
-               Sampler& rng, uint64_t& rays, ShadowSink& shadow, bool diffuse_lit) {
+               Sampler& rng, uint64_t& rays, ShadowSink& shadow) {
   const int bounce = st.bounce++;
   if (!found) {
     if constexpr ((F & kFeatInfinite) != 0) {
@@ -299,8 +230,6 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
     if (material.type == MaterialType::emission) return false;  // the course's emitters reflect nothing
   }
   if (st.depth_left == 0) return false;
-  if (diffuse_lit && material.type == MaterialType::diffuse)
-    return diffuse_vertex(scene, settings, st, bounce, hit, material, rng, rays, shadow);
 
   // Shading frame. Opaque surfaces are two-sided: turn the normals towards the viewer.
   Vec3 ng = hit.ng;

@@ -269,7 +269,8 @@ size_t SceneBase::memory_bytes() const {
 namespace {
 
 // A view from a base taken by value: make_render_scene moves its fresh base in, make_view copies.
-std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params) {
+std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params,
+                                     std::shared_ptr<const EnvironmentMap> environment) {
   auto rs = std::make_unique<RenderScene>();
   rs->materials = std::move(base.materials);
   rs->lights = std::move(base.lights);
@@ -280,8 +281,11 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
   SceneFeatures& f = rs->features;
   f = std::move(base.features);
   if (!params.env_map.empty()) {
-    ImageRGB env = read_image(params.env_map);
-    auto map = std::make_shared<const EnvironmentMap>(env.width, env.height, std::move(env.pixels));
+    std::shared_ptr<const EnvironmentMap> map = std::move(environment);
+    if (!map) {
+      ImageRGB env = read_image(params.env_map);
+      map = std::make_shared<const EnvironmentMap>(env.width, env.height, std::move(env.pixels));
+    }
     Light l;
     l.kind = LightKind::environment;
     l.name = params.env_map;
@@ -342,14 +346,15 @@ std::unique_ptr<RenderScene> view_of(SceneBase base, const RenderParams& params)
 
 }  // namespace
 
-std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams& params) {
+std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams& params,
+                                       std::shared_ptr<const EnvironmentMap> environment) {
   params.validate();
-  return view_of(base, params);
+  return view_of(base, params, std::move(environment));
 }
 
 std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const RenderParams& params) {
   params.validate();  // before the build: a bad option fails fast
-  return view_of(make_scene_base(desc), params);
+  return view_of(make_scene_base(desc), params, nullptr);
 }
 
 float autofocus_distance(const RenderScene& scene, float sx, float sy) {

@@ -60,16 +60,6 @@ struct SceneBase {
   size_t memory_bytes() const;
 };
 
-// The forms the path loop runs in. Users always get the defaults; tests and benchmarks turn them
-// off on a view to compare the forms, which render the same images.
-struct LoopForms {
-  bool packets = true;  // camera paths many at once, their rays in Embree packets (-H: never)
-  // Diffuse vertices under area lights by the lanes' text (diffuse_lanes.h: one path at a time at
-  // width 1, packets' vertices four or eight at a time), packets' sample draws in SIMD lanes. False:
-  // path_step's generic vertex, the reference the tests compare the lanes with.
-  bool lanes = true;
-};
-
 // The default light of a glTF scene without lights or emitters (SceneDesc::default_light): a
 // uniform environment of this radiance plus a sun of this irradiance (W/m^2) shining from this
 // direction (towards the sun: above, in front, a little to the side of the default view).
@@ -77,7 +67,6 @@ constexpr float kDefaultEnvironment = 0.5f, kDefaultSunIrradiance = 2.0f;
 inline const Vec3 kDefaultSunDirection = normalize(Vec3(0.25f, 0.85f, 0.45f));
 
 struct RenderScene {
-  LoopForms loop;
   std::vector<Material> materials;
   std::vector<Light> lights;
   std::vector<int> infinite_lights;  // ambient / environment, looked up when rays escape
@@ -125,8 +114,10 @@ std::unique_ptr<RenderScene> make_render_scene(const SceneDesc& desc, const Rend
 // The expensive, options-independent part: lights, materials, the BVH, the feature analysis.
 SceneBase make_scene_base(const SceneDesc& desc);
 // One view of a shared base for a set of options: the camera, the environment map, the options'
-// features. Cheap (copies materials and lights); the view shares the base's BVH.
-std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams& params);
+// features. Cheap (copies materials and lights); the view shares the base's BVH. `environment`:
+// the map params.env_map names, already loaded by an earlier view (the window's sessions share it).
+std::unique_ptr<RenderScene> make_view(const SceneBase& base, const RenderParams& params,
+                                       std::shared_ptr<const EnvironmentMap> environment = nullptr);
 // The camera part of the render options (what make_render_scene passes to make_camera).
 CameraParams camera_params(const RenderParams& params);
 

@@ -80,8 +80,8 @@ class Sampler {
   // next_2d() of samplers s[0], ..., s[n - 1], bit for bit: the Sobol draws eight at a time in
   // AVX2 lanes where the CPU has them (sampler_lanes.cpp), the rest one at a time. `lanes` false
   // draws every one alone (for tests and comparisons).
-  static void next_2d_many(Sampler* s, size_t n, Vec2* out, bool lanes = true);
-  static void next_2d_many(Sampler* const* s, size_t n, Vec2* out, bool lanes = true);
+  static void next_2d_many(Sampler* s, size_t n, Vec2* out);
+  static void next_2d_many(Sampler* const* s, size_t n, Vec2* out);
   // Draw number `draw` (1 for the first) of the fresh Sobol samplers (base[i], sample[i]), i < n,
   // as their next_2d() would give it, without the samplers: for the camera's draws of many
   // samples at once. Needs lanes_available().

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "lane_math.h"
+#include "loop_forms.h"
 #include "sampler.h"
 
 PT_BEGIN_AVX2
@@ -73,8 +74,8 @@ struct AlignedAllocator {
 // Reads and writes the samplers' state for the lanes; a friend of Sampler.
 struct SamplerLanes {
   template <class At>
-  static void draw(At s, size_t n, Vec2* out, bool lanes) {
-    if (!lanes || !Sampler::lanes_available()) {
+  static void draw(At s, size_t n, Vec2* out) {
+    if (!forms::lanes() || !Sampler::lanes_available()) {
       for (size_t i = 0; i < n; ++i) out[i] = s(i).next_2d();
       return;
     }
@@ -123,12 +124,12 @@ void Sampler::sobol_draws(const uint32_t* base, const uint32_t* sample, size_t n
 
 bool Sampler::lanes_available() { return simd::avx2_available(); }
 
-void Sampler::next_2d_many(Sampler* s, size_t n, Vec2* out, bool lanes) {
-  SamplerLanes::draw([s](size_t i) -> Sampler& { return s[i]; }, n, out, lanes);
+void Sampler::next_2d_many(Sampler* s, size_t n, Vec2* out) {
+  SamplerLanes::draw([s](size_t i) -> Sampler& { return s[i]; }, n, out);
 }
 
-void Sampler::next_2d_many(Sampler* const* s, size_t n, Vec2* out, bool lanes) {
-  SamplerLanes::draw([s](size_t i) -> Sampler& { return *s[i]; }, n, out, lanes);
+void Sampler::next_2d_many(Sampler* const* s, size_t n, Vec2* out) {
+  SamplerLanes::draw([s](size_t i) -> Sampler& { return *s[i]; }, n, out);
 }
 
 }  // namespace pt

@@ -1,5 +1,5 @@
-// The render session (session.h): tiles, passes on the render threads, the scene rectangle that
-// background pixels skip, and the light tracer's share of each pass.
+// The render session (session.h): tiles, passes on the render threads, and the light tracer's share
+// of each pass.
 #include "session.h"
 
 #include <algorithm>
@@ -45,21 +45,15 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
   const int w = width(), h = height();
   if (m_path.caustics_light_traced) m_caustic_film = {params.width, params.height, m_frame_x0, m_frame_y0, w, h};
   m_tiles = tile_grid(w, h, params.tile_size);
-  find_scene_rectangle();
+  m_background = BackgroundMask(scene, params, m_frame_x0, m_frame_y0, w, h);
   // Before any pass, a tile's cost is its pixels that see the scene.
   m_tile_ns.assign(m_tiles.size(), 0);
   m_tile_samples.assign(m_tiles.size(), 0);
   for (size_t t = 0; t < m_tiles.size(); ++t) {
     const Tile& tile = m_tiles[t];
     uint64_t seen = 0;
-    for (int y = tile.y0; y < tile.y1; ++y) {
-      if (m_background.empty()) {
-        for (int x = tile.x0; x < tile.x1; ++x) seen += !background_pixel(size_t(y) * w + x, x, y);
-        continue;
-      }
-      const uint8_t* row = m_background.data() + size_t(y) * w;
-      for (int x = tile.x0; x < tile.x1; ++x) seen += row[x] == 0;
-    }
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x) seen += !m_background.film_pixel(size_t(y) * w + x, x, y);
     m_tile_ns[t] = seen;
   }
   order_tiles_by_cost();
@@ -72,102 +66,7 @@ void RenderSession::order_tiles_by_cost() {
                    [&](uint32_t a, uint32_t b) { return m_tile_ns[a] > m_tile_ns[b]; });
 }
 
-// Where the scene's (padded) bounding box projects on the sensor of a camera in front of it. The
-// box is convex and wholly in front, so every pinhole ray that can hit it passes inside the box
-// spanned by its eight projected corners; a pixel wholly outside (with a pixel of margin) sees only
-// background. Without an environment seen by the camera, background is exactly black and the
-// path loop would stop at its first, missed query: the sample is black and counts one ray.
-// A thin lens sees a point at depth z from lens point l at sensor position p/z - l (1/z - 1/f)
-// (camera.cpp's ray through the focus point p f / z): the rectangle grows by the lens radius times
-// the largest |1/z - 1/f| over the box, which a corner (the nearest or farthest) attains.
-namespace {
-
-// The frame-pixel rectangle (y up, unclipped, without margin) holding box [lo, hi] as the camera
-// sees it, or false when a corner lies beside or behind the camera (no rectangle holds it).
-bool project_box(const Camera& cam, int width, int height, Vec3 lo, Vec3 hi, float r[4]) {
-  const bool lens = cam.lens_radius > 0;
-  float u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf, blur = 0;
-  for (int c = 0; c < 8; ++c) {
-    Vec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
-    Vec3 v = corner - cam.position;
-    float z = -dot(v, cam.back);
-    if (!(z > 1e-3f * length(v))) return false;
-    float u = (dot(v, cam.right) / (z * cam.tan_half_w) + 1) * 0.5f * float(width);
-    float w = (dot(v, cam.up) / (z * cam.tan_half_h) + 1) * 0.5f * float(height);
-    if (!std::isfinite(u) || !std::isfinite(w)) return false;
-    u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, w), v1 = std::max(v1, w);
-    if (lens) blur = std::max(blur, cam.lens_radius * std::fabs(1 / z - 1 / cam.focal_distance));
-  }
-  if (lens) {  // blur is in sensor units (tan); pixels per unit differ along x and y
-    float bu = blur * 0.5f * float(width) / cam.tan_half_w, bv = blur * 0.5f * float(height) / cam.tan_half_h;
-    if (!std::isfinite(bu) || !std::isfinite(bv)) return false;
-    u0 -= bu, u1 += bu, v0 -= bv, v1 += bv;
-  }
-  r[0] = u0, r[1] = u1, r[2] = v0, r[3] = v1;
-  return true;
-}
-
-}  // namespace
-
-void RenderSession::find_scene_rectangle() {
-  const Camera& cam = m_scene.camera;
-  const int w = width(), h = height();
-  Vec3 lo, hi;
-  if (!m_scene.accel || !m_scene.accel->hit_bounds(lo, hi)) return;
-  if (!(cam.tan_half_w > 0) || !(cam.tan_half_h > 0)) return;
-  if (cam.lens_radius > 0 && !(cam.focal_distance > 0 && std::isfinite(cam.focal_distance))) return;
-  float r[4];
-  if (!project_box(cam, m_params.width, m_params.height, lo, hi, r)) return;
-  m_scene_u0 = r[0] - 1, m_scene_u1 = r[1] + 1, m_scene_v0 = r[2] - 1, m_scene_v1 = r[3] + 1;
-  // The caustic light paths are counted on this area, clipped to the full frame (not to a crop or
-  // cell window, so that windows trace the frame's paths): a box around a close camera projects far
-  // past the frame, and light paths only splat inside it.
-  auto clipped = [](float a, float b, float size) {
-    return std::max(0.0, double(std::min(b, size)) - double(std::max(a, 0.0f)));
-  };
-  m_scene_pixels = clipped(m_scene_u0, m_scene_u1, float(m_params.width)) * clipped(m_scene_v0, m_scene_v1, float(m_params.height));
-  m_background_rect = m_scene.environment_light < 0;
-  if (!m_background_rect || size_t(w) * h > (size_t(1) << 24)) return;
-
-  // Within the rectangle, the pixels no object's own rectangle reaches (the sky above an open
-  // floor), for a bounded number of objects: the mask starts as "no object" and each object's
-  // rectangle clears its rows' spans. Without that (no objects, too many, or one that does not
-  // project), the rectangle alone decides.
-  const auto& objects = m_scene.object_bounds;
-  bool by_objects = !objects.empty() && objects.size() <= kMaxMaskedObjects;
-  m_background.assign(size_t(w) * h, by_objects ? 1 : 0);
-  for (size_t k = 0; k < objects.size() && by_objects; ++k) {
-    const Bounds3& b = objects[k];
-    if (!project_box(cam, m_params.width, m_params.height, b.lo, b.hi, r)) {
-      by_objects = false;
-      std::fill(m_background.begin(), m_background.end(), uint8_t(0));
-      break;
-    }
-    // Film pixels whose frame pixel [fx, fx + 1] x [fy, fy + 1] meets the rectangle grown by a pixel.
-    auto px = [](float v, int size) { return int(std::clamp(v, -4.0f, float(size) + 4)); };
-    int fx0 = px(std::floor(r[0] - 2), m_params.width), fx1 = px(std::ceil(r[1] + 1), m_params.width);
-    int fy0 = px(std::floor(r[2] - 2), m_params.height), fy1 = px(std::ceil(r[3] + 1), m_params.height);
-    int x0 = std::max(fx0 - m_frame_x0, 0), x1 = std::min(fx1 - m_frame_x0, w - 1);
-    if (x0 > x1) continue;
-    for (int fy_up = std::max(fy0, 0); fy_up <= std::min(fy1, m_params.height - 1); ++fy_up) {
-      int y = (m_params.height - 1 - fy_up) - m_frame_y0;
-      if (y < 0 || y >= h) continue;
-      uint8_t* row = m_background.data() + size_t(y) * w;
-      std::fill(row + x0, row + x1 + 1, uint8_t(0));
-    }
-  }
-  // Then the rectangle, which is a product of a column range and a row range.
-  std::vector<uint8_t> column_outside(static_cast<size_t>(w));
-  for (int x = 0; x < w; ++x) column_outside[size_t(x)] = outside_scene_columns(m_frame_x0 + x);
-  for (int y = 0; y < h; ++y) {
-    uint8_t* row = m_background.data() + size_t(y) * w;
-    if (outside_scene_rows(m_params.height - 1 - (m_frame_y0 + y))) std::fill(row, row + w, uint8_t(1));
-    else
-      for (int x = 0; x < w; ++x) row[x] |= column_outside[size_t(x)];
-  }
-}
-
-// Light paths per sample and pixel of the area where the scene's bounds project (find_scene_rectangle),
+// Light paths per sample and pixel of the area where the scene's bounds project (background_mask.h),
 // so that the splats per pixel do not depend on the framing. The light paths are aimed at the delta
 // geometry and most of them splat, so few are needed: on CBspheres at 480x360 (m = 5, 64 spp; the
 // scene covers 57520 pixels) 0.045 / 0.09 / 0.19 / 0.38 / 1.5 paths per scene pixel gave
@@ -183,7 +82,7 @@ constexpr double kLightPathsPerScenePixel = 0.15, kMaxLightPathsPerSample = 1.0;
 // full frame), and a share of sample indices (set_sample_range) its share of light paths.
 uint64_t RenderSession::light_paths_for(uint64_t samples) const {
   const double frame = double(m_params.width) * m_params.height;
-  const double scene = m_scene_pixels >= 0 ? m_scene_pixels : frame;
+  const double scene = m_background.scene_pixels() >= 0 ? m_background.scene_pixels() : frame;
   const double per_sample = std::min(kMaxLightPathsPerSample * frame, kLightPathsPerScenePixel * scene);
   return uint64_t(std::ceil(per_sample * double(samples)));
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "background_mask.h"
 #include "caustics.h"
 #include "driver.h"
 #include "film.h"
@@ -75,39 +76,16 @@ class RenderSession : public PassSource {
   // whose `skip` byte is set are left out. Call before the first pass.
   void set_sample_range(uint32_t first, const std::vector<uint8_t>& skip);
   // True when every camera ray of frame pixel (fx, fy_up) (y up, as the course counts rows) misses
-  // the scene, so that its samples are black without a ray query (see find_scene_rectangle).
-  bool sees_only_background(int fx, int fy_up) const {
-    if (!m_background_rect) return false;
-    int x = fx - m_frame_x0, y = (m_params.height - 1 - fy_up) - m_frame_y0;
-    if (!m_background.empty() && x >= 0 && y >= 0 && x < width() && y < height())
-      return m_background[size_t(y) * width() + x];
-    return outside_scene_rectangle(fx, fy_up);
-  }
-  // Objects whose own projected rectangles refine the scene's (find_scene_rectangle).
-  static constexpr size_t kMaxMaskedObjects = 256;
+  // the scene, so that its samples are black without a ray query (background_mask.h).
+  bool sees_only_background(int fx, int fy_up) const { return m_background.sees_only_background(fx, fy_up); }
 
  private:
-  void find_scene_rectangle();
   void order_tiles_by_cost();  // m_tile_order from m_tile_ns, ties in raster order
-  bool outside_scene_rectangle(int fx, int fy_up) const { return outside_scene_columns(fx) || outside_scene_rows(fy_up); }
-  bool outside_scene_columns(int fx) const { return fx + 1 < m_scene_u0 || fx > m_scene_u1; }
-  bool outside_scene_rows(int fy_up) const { return fy_up + 1 < m_scene_v0 || fy_up > m_scene_v1; }
-  // sees_only_background for film pixel i = y width + x, from the mask where there is one (the tile
-  // loops ask once per pixel and pass).
-  bool background_pixel(size_t i, int x, int y) const {
-    if (!m_background.empty()) return m_background[i] != 0;
-    return sees_only_background(m_frame_x0 + x, m_params.height - 1 - (m_frame_y0 + y));
-  }
   void trace_caustics(int target_spp, const std::atomic<bool>* cancel);
   uint64_t light_paths_for(uint64_t samples) const;
-  // session_tile.cpp: a tile's samples up to target_spp, path by path or in packets.
+  // session_tile.cpp: a tile's samples up to target_spp, in packets or path by path.
   void render_tile(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
                    uint64_t& samples, uint64_t& nonfinite);
-  void render_tile_batched(const Tile& t, int target_spp, const std::atomic<bool>* cancel, uint64_t& rays,
-                           uint64_t& samples, uint64_t& nonfinite, PathBatchTracer trace);
-  // The pixel sample's point on the sensor (its jitter draw), and its camera ray (+ the lens draw).
-  Vec2 sensor_sample(int fx, int fy_up, Sampler& rng) const;
-  void camera_ray(int fx, int fy_up, Sampler& rng, Ray& r) const;
 
   const RenderScene& m_scene;
   RenderParams m_params;
@@ -116,15 +94,7 @@ class RenderSession : public PassSource {
   // caustic paths (caustics.h), which the loop then leaves out.
   PathSettings m_path;
   Film m_film;
-  // Pixels whose every camera ray misses the scene (frame pixel coordinates, y up): outside this
-  // rectangle a sample is black and costs no ray query. Off (empty) for a visible environment.
-  bool m_background_rect = false;
-  float m_scene_u0 = 0, m_scene_u1 = 0, m_scene_v0 = 0, m_scene_v1 = 0;
-  double m_scene_pixels = -1;  // the projected bounds' area within the full frame (-1: unknown)
-  // Film pixels that see only background: outside the rectangle, or inside it where no object's
-  // own rectangle reaches. Empty without a rectangle, or for films over 2^24 pixels (the
-  // rectangle alone decides there).
-  std::vector<uint8_t> m_background;
+  BackgroundMask m_background;  // pixels whose samples are black without a ray query
   uint32_t m_first_sample = 0;
   std::vector<Tile> m_tiles;
   // The order threads take tiles in: the costliest first (the last pass's time, at first the

@@ -25,6 +25,52 @@ bool accepts_reference(const Ray& r) {
   return !std::isnan(r.tmin) && !std::isnan(r.tmax);
 }
 
+// The scalar forms of refine_triangle and refine_sphere, the references their SSE must match bit
+// for bit. The hit record of a hit on triangle `prim` at t with barycentrics (u, v): the point from the
+// barycentrics (not o + t d, which drifts off the plane), the unit face normal (for a degenerate
+// triangle, from `eng()`: Embree's unnormalised one), the interpolated shading normal, material, light.
+// `Attributes`: the scene has meshes with uvs or colours (false skips even the check).
+template <bool Attributes = true, class EmbreeNormal>
+void refine_triangle_scalar(const TriangleData& m, unsigned prim, float t, float u, float v, EmbreeNormal&& eng,
+                                   SurfaceHit& hit) {
+  (void)t;  // the point comes from the barycentrics
+  const uint32_t* tri = m.indices + 3 * size_t(prim);
+  const TriangleInfo& info = m.tris[prim];
+  auto at = [&](const float* base, uint32_t i) { return Vec3(base[3 * size_t(i)], base[3 * size_t(i) + 1], base[3 * size_t(i) + 2]); };
+  const float w = 1 - u - v;
+  hit.p = at(m.positions, tri[0]) * w + at(m.positions, tri[1]) * u + at(m.positions, tri[2]) * v;
+  Vec3 ng = info.ng;
+  if (is_black(ng)) {
+    ng = normalize(eng());
+    if (is_black(ng)) ng = Vec3(0, 1, 0);
+  }
+  hit.ng = ng;
+  hit.ns = ng;
+  if (m.normals) {
+    Vec3 ns = normalize(at(m.normals, tri[0]) * w + at(m.normals, tri[1]) * u + at(m.normals, tri[2]) * v);
+    if (!is_black(ns)) hit.ns = ns;
+  }
+  hit.material = info.material;
+  hit.light = info.light;
+  hit.offset = 0;
+  if (Attributes && m.attributes) note_attributes(m, prim, u, v, hit);
+}
+
+// The hit record of a hit on sphere s (centre x y z, radius) at t: the point re-projected onto the
+// sphere, which removes the error of o + t d, and the outward normal.
+void refine_sphere_scalar(const float* s, int material, const Ray& ray, float t, SurfaceHit& hit) {
+  const Vec3 c(s[0], s[1], s[2]);
+  const float r = s[3];
+  Vec3 n = normalize(ray.o + ray.d * t - c);
+  if (is_black(n)) n = Vec3(0, 1, 0);
+  hit.p = c + n * r;
+  hit.ng = hit.ns = n;
+  hit.material = material;
+  hit.light = -1;
+  // Embree's sphere test loses ~ulp(r)/cos near the surface; push far enough to clear it.
+  hit.offset = 1e-5f * r;
+}
+
 // The scalar slab test, written out (Kay & Kajiya), with the NaN-skipping max and min.
 bool bounds_reference(const Ray& r, const float lo[3], const float hi[3]) {
   auto mx = [](float a, float b) { return a > b ? a : b; };

@@ -1,5 +1,6 @@
 // Camera placement (course framing, authored, settings file) and thin-lens geometry.
 #include "camera.h"
+#include "loop_forms.h"
 
 #include <gtest/gtest.h>
 
@@ -217,9 +218,9 @@ Camera tilted_camera(Vec3 back) {
 TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
   Camera c = tilted_camera(Vec3(0.3f, -0.5f, 0.8f));
   Pcg32 rng(7, 11);
-  test::AllowAvx2Afterwards restore;
   for (bool avx2 : {true, false}) {
-    simd::allow_avx2(avx2);
+    forms::Scoped forms;
+    forms->avx2 = avx2;
     for (size_t n : {size_t(0), size_t(1), size_t(4), size_t(7), size_t(13), size_t(1001)}) {
       SCOPED_TRACE(testing::Message() << (avx2 ? "AVX2 where the CPU has it" : "SSE2") << ", " << n << " rays");
       std::vector<float> sx(n), sy(n);
@@ -248,9 +249,9 @@ TEST(Camera, PinholeRaysInLanesAreThePinholeRaysBits) {
 TEST(Camera, ThinLensRaysInLanesAreGenerateRaysBits) {
   Camera c = tilted_camera(Vec3(-0.6f, 0.2f, 0.7f));
   Pcg32 rng(3, 5);
-  test::AllowAvx2Afterwards restore;
   for (bool avx2 : {true, false}) {
-    simd::allow_avx2(avx2);
+    forms::Scoped forms;
+    forms->avx2 = avx2;
     for (auto [radius, focus] : {std::pair{0.2f, 3.5f}, std::pair{0.3f, 0.0f}, std::pair{0.0f, 4.7f}}) {
       c.lens_radius = radius, c.focal_distance = focus;
       for (size_t n : {size_t(0), size_t(3), size_t(8), size_t(13), size_t(1001)}) {

@@ -12,6 +12,7 @@
 
 #include "caustics.h"
 #include "collada.h"
+#include "loop_forms.h"
 #include "materials.h"
 #include "session.h"
 #include "test_util.h"
@@ -217,7 +218,8 @@ TEST(Caustics, PooledLightPathsSplatAsOnePathAtATime) {
   SceneDesc desc = load_collada(test::own_scene("cornell.dae"));
   RenderParams p = cornell_params();
   auto scene = make_render_scene(desc, p);
-  scene->loop.packets = false;
+  forms::Scoped one_ray_queries;
+  one_ray_queries->packets = false;
   ASSERT_TRUE(scene->features.caustic_tracing);
   const CausticFilm film{p.width, p.height, 0, 0, p.width, p.height};
   std::vector<CausticSplat> pooled, single;

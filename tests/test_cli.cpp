@@ -211,16 +211,6 @@ TEST(Cli, RendersPngRateImageAndExrWithMetadata) {
   EXPECT_EQ(in->spec().get_string_attribute("pathtracer:nonfinite_samples"), "0");
   EXPECT_FALSE(in->spec().get_string_attribute("pathtracer:wall_seconds").empty());
   EXPECT_FALSE(in->spec().get_string_attribute("pathtracer:achieved_spp").empty());
-  // The packet width Embree actually takes on this CPU (16 with AVX-512, else 8), as --describe says.
-  std::smatch width;
-  RunResult described = run("--describe " + scene);
-  ASSERT_TRUE(std::regex_search(described.output, width, std::regex("Embree packets of ([0-9]+)"))) << described.output;
-  EXPECT_EQ(in->spec().get_string_attribute("pathtracer:ray_packets"), width[1].str());
-  r = run("-s 4 -m 2 -r 64 48 -H --quiet -f " + dir + "/single.exr " + scene);  // -H casts one ray at a time
-  ASSERT_EQ(r.status, 0) << r.output;
-  in = OIIO::ImageInput::open(dir + "/single.exr");
-  ASSERT_TRUE(in);
-  EXPECT_EQ(in->spec().get_string_attribute("pathtracer:ray_packets"), "off");
 }
 
 TEST(Cli, BadSceneFailsWithALocatedMessage) {

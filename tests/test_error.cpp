@@ -5,6 +5,7 @@
 #include <random>
 
 #include "collada.h"
+#include "loop_forms.h"
 #include "session.h"
 #include "test_util.h"
 
@@ -219,7 +220,8 @@ TEST(ErrorEstimateBackground, AFrameOfBackgroundOnlyIsConvergedFromTwoSamples) {
       p.lens_radius = lens;
       p.focal_distance = 2;
       auto scene = make_render_scene(d, p);
-      scene->loop.packets = packets;
+      forms::Scoped forms;
+      forms->packets = packets;
       RenderSession s(*scene, p);
       for (int fy = 0; fy < p.height; ++fy)
         for (int fx = 0; fx < p.width; ++fx) ASSERT_TRUE(s.sees_only_background(fx, fy)) << fx << " " << fy;

@@ -8,6 +8,7 @@
 
 #include "collada.h"
 #include "diffuse_lanes.h"
+#include "loop_forms.h"
 #include "session.h"
 #include "test_util.h"
 
@@ -76,10 +77,12 @@ TEST(Packets, BatchedPathsRenderWhatThePathByPathLoopRenders) {
     ASSERT_NE(path_batch_tracer_for(scene->features.bits, PathSettings(p)), nullptr);
     RenderSession batched(*scene, p);
     batched.render_all();
-    RenderScene one_by_one = *scene;
-    one_by_one.loop.packets = false;
-    RenderSession single(one_by_one, p);
-    single.render_all();
+    RenderSession single(*scene, p);
+    {
+      forms::Scoped one_by_one;
+      one_by_one->packets = false;
+      single.render_all();
+    }
     ImageRGB a = batched.image(), b = single.image();
     ASSERT_EQ(a.pixels.size(), b.pixels.size());
     EXPECT_LE(differing_pixels(a, b), a.pixels.size() / 200) << "more than 0.5% of the pixels differ";
@@ -92,8 +95,9 @@ TEST(Packets, BatchedPathsRenderWhatThePathByPathLoopRenders) {
 }
 
 // The SSE2 and AVX2 lanes (diffuse_lanes.h) repeat path_step's generic vertex operation for
-// operation: with them and without, the batched loop must render the same bits, count the same
-// rays and stop the same pixels. Depth 8 makes paths reach Russian roulette (from the sixth vertex).
+// operation (the path-by-path loop runs only the generic one): with them and without, the batched
+// loop must render the same bits, count the same rays and stop the same pixels. Depth 8 makes
+// paths reach Russian roulette (from the sixth vertex).
 TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
   std::vector<Case> all = cases();
   for (Case& c : all) c.params.max_depth = 8;
@@ -107,14 +111,16 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
     RenderParams p = c.params;
     auto scene = make_render_scene(desc, p);
     laned += diffuse_lanes_apply(*scene, PathSettings(p));
-    RenderScene scalar = *scene;
-    scalar.loop.lanes = false;
-    EXPECT_FALSE(diffuse_lanes_apply(scalar, PathSettings(p)));
-    RenderSession without(scalar, p);
-    without.render_all();
-    test::AllowAvx2Afterwards restore;
+    RenderSession without(*scene, p);
+    {
+      forms::Scoped scalar;
+      scalar->lanes = false;
+      EXPECT_FALSE(diffuse_lanes_apply(*scene, PathSettings(p)));
+      without.render_all();
+    }
     for (bool avx2 : {true, false}) {  // eight lanes where the CPU has AVX2, and four (SSE2)
-      simd::allow_avx2(avx2);
+      forms::Scoped width;
+      width->avx2 = avx2;
       SCOPED_TRACE(testing::Message() << lanes::lane_width() << " lanes");
       RenderSession with(*scene, p);
       with.render_all();
@@ -127,35 +133,6 @@ TEST(Packets, DiffuseLanesRenderTheBitsOfOneVertexAtATime) {
     }
   }
   EXPECT_GE(laned, 6) << "the own scenes' lights take the lanes: rectangles (1 or 3 samples), a mesh";
-}
-
-// Path by path, the lanes' text runs at width 1 (path_step's diffuse_vertex): it must render the
-// bits of the generic vertex it stands in for, with the same rays and adaptive stops.
-TEST(Packets, TheLanesTextAtWidthOneRendersTheGenericVertexBits) {
-  std::vector<Case> all = cases();
-  for (Case& c : all) c.params.max_depth = 8;  // into Russian roulette
-  all.push_back({"cornell with a mesh light, depth 8", "", all[0].params});
-  int laned = 0;
-  for (const Case& c : all) {
-    SCOPED_TRACE(c.name);
-    SceneDesc desc = load_collada(c.path.empty() ? test::own_scene("cornell.dae") : c.path);
-    if (c.path.empty()) test::area_lights_as_meshes(desc);
-    RenderParams p = c.params;
-    auto scene = make_render_scene(desc, p);
-    scene->loop.packets = false;
-    laned += diffuse_lanes_apply(*scene, PathSettings(p));
-    RenderScene generic = *scene;
-    generic.loop.lanes = false;
-    RenderSession with(*scene, p), without(generic, p);
-    with.render_all();
-    without.render_all();
-    ImageRGB a = with.image(), b = without.image();
-    ASSERT_EQ(a.pixels.size(), b.pixels.size());
-    EXPECT_EQ(differing_pixels(a, b), 0u);
-    EXPECT_EQ(with.stats().rays, without.stats().rays);
-    EXPECT_EQ(with.film().done_mask(), without.film().done_mask());
-  }
-  EXPECT_GE(laned, 5) << "the own scenes' lights take the lanes' text: rectangles (1 or 3 samples), a mesh";
 }
 
 TEST(Packets, DiffuseLanesTakeOnlyAreaLights) {

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "collada.h"
+#include "loop_forms.h"
 #include "session.h"
 #include "test_util.h"
 
@@ -373,7 +374,8 @@ TEST(Adaptive, ProgressCountsStoppedPixelsAsDone) {
     p.adaptive_batch = 32;
     p.adaptive = false;
     auto scene = make_render_scene(desc, p);
-    scene->loop.packets = packets;
+    forms::Scoped forms;
+    forms->packets = packets;
     RenderSession fixed(*scene, p);
     for (int target : {1, 16, 64}) {
       fixed.render_pass(target);

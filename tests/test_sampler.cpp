@@ -1,6 +1,7 @@
 // The random numbers: the PCG32 generator and the per-sample sampler (Owen-scrambled Sobol, its
 // draws in lanes). Distribution checks are chi-square goodness-of-fit tests at significance 1e-3
 // with fixed seeds, so every run sees the same numbers.
+#include "loop_forms.h"
 #include "sampler.h"
 
 #include <gtest/gtest.h>
@@ -202,6 +203,8 @@ TEST(Sampler, SameInputsSameNumbersAndIndependentModeIsPcg) {
 TEST(Sampler, ManyDrawsAtOnceAreEachSamplersOwnDraws) {
   for (bool lanes : {false, true}) {
     SCOPED_TRACE(lanes ? "lanes" : "one at a time");
+    forms::Scoped forms;
+    forms->lanes = lanes;
     std::vector<Sampler> mine, ref;
     std::vector<int> skips;
     for (uint32_t k = 0; k < 61; ++k) {  // not a multiple of 8: a partial group
@@ -217,13 +220,13 @@ TEST(Sampler, ManyDrawsAtOnceAreEachSamplersOwnDraws) {
     std::vector<Vec2> out(mine.size());
     for (int round = 0; round < 6; ++round) {
       if (round % 2 == 0) {
-        Sampler::next_2d_many(mine.data(), mine.size(), out.data(), lanes);
+        Sampler::next_2d_many(mine.data(), mine.size(), out.data());
         for (size_t k = 0; k < mine.size(); ++k) {
           Vec2 want = ref[k].next_2d();
           ASSERT_EQ(std::memcmp(&want, &out[k], sizeof want), 0) << "sampler " << k << " round " << round;
         }
       } else {
-        Sampler::next_2d_many(every_other.data(), every_other.size(), out.data(), lanes);
+        Sampler::next_2d_many(every_other.data(), every_other.size(), out.data());
         for (size_t k = 0; k < every_other.size(); ++k) {
           Vec2 want = ref[2 * k].next_2d();
           ASSERT_EQ(std::memcmp(&want, &out[k], sizeof want), 0) << "sampler " << 2 * k << " round " << round;

@@ -52,12 +52,6 @@ inline std::string diffuse_sphere_scene(float rho, float camera_z, float fov, co
   return s.str();
 }
 
-// Tests that run the SSE2 paths on an AVX2 machine (simd::allow_avx2(false)) hold one of these: a
-// failed ASSERT must not leave the AVX2 paths off for the tests after it.
-struct AllowAvx2Afterwards {
-  ~AllowAvx2Afterwards() { simd::allow_avx2(true); }
-};
-
 // A command's exit status (-1 when it did not exit) and its stdout and stderr together.
 struct RunResult {
   int status;

@@ -37,8 +37,16 @@ TEST(ViewerCli, HelpListsTheWindowKeys) {
   EXPECT_EQ(r.status, 0);
   EXPECT_NE(r.output.find("Window keys"), std::string::npos);
   for (const char* k : {"R ", ". / ,", "L / K", "' / ;", "] / [", "= / -", "T ", "S ", "D ", "click", "H (or `)", "? (/)",
-                        "Esc / Q", "--script", "--output-dir"})
+                        "Esc / Q", "--output-dir"})
     EXPECT_NE(r.output.find(k), std::string::npos) << k;
+}
+
+// The script player is the test build's (pathtracer-scripted): the shipped command does not know it.
+TEST(ViewerCli, TheShippedCommandHasNoScriptPlayer) {
+  test::RunResult r = test::run_command(std::string(PT_PATHTRACER) + " --script x.txt " + test::own_scene("cornell.dae"));
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("unknown option '--script'"), std::string::npos) << r.output;
+  EXPECT_EQ(test::run_command(std::string(PT_PATHTRACER) + " --help").output.find("--script"), std::string::npos);
 }
 
 TEST(ViewerCli, WithoutADisplayExitsWith2AndSaysSo) {

@@ -33,7 +33,7 @@ struct RunResult {
 };
 
 inline RunResult run(const std::string& args, const std::string& env = "") {
-  std::string cmd = env + " timeout 120 " + std::string(PT_PATHTRACER) + " " + args + " 2>&1";
+  std::string cmd = env + " timeout 120 " + std::string(PT_PATHTRACER_SCRIPTED) + " " + args + " 2>&1";
   auto t0 = std::chrono::steady_clock::now();
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;

@@ -168,7 +168,6 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
       o.checkpoint = args[++i];
       if (o.checkpoint.empty()) throw UsageError("--checkpoint: empty file name");
     } else if (a == "--checkpoint-interval") { need(a, 1); o.checkpoint_interval = parse_float(a, args[++i], 0, 1e9); }
-    else if (a == "--script") { need(a, 1); o.script = args[++i]; }
     else if (a == "--output-dir") {
       need(a, 1);
       o.output_dir = args[++i];
@@ -256,10 +255,6 @@ std::string usage_text(const std::string& program) {
 "                         continues it from there (the finished image is the same, bit for bit)\n"
 "  --checkpoint-interval <SEC>  seconds between checkpoints (default 30; 0 = after every pass)\n"
 "  --output-dir <DIR>  window only: where S and D write (default: the current directory)\n"
-"  --script <FILE> window only: replay input from FILE, one command a line (for tests):\n"
-"                  wait_spp N | wait_ms N | key K | click X Y | resize W H | sync |\n"
-"                  drag left|right X0 Y0 X1 Y1 STEPS | wheel N |\n"
-"                  title | overlay | screenshot FILE.png | close | quit\n"
 "\n"
 "Window keys (without -f; the render restarts after each change):\n" + window_keys_text() +
 "  The render follows the window's size: -r gives the initial window size.\n";
@@ -316,8 +311,6 @@ Metadata render_metadata(const CliOptions& o, const RenderSession& session) {
     meta.push_back({opt.metadata, option_text(opt, opt.get(p, o.limits))});
   Metadata run{{"pathtracer:achieved_spp", num(pixels > 0 ? st.samples / pixels : 0)},
                {"pathtracer:direct", p.hemisphere ? "hemisphere" : "light sampling"},
-               {"pathtracer:ray_packets",
-                packets_apply(session.scene(), p) ? std::to_string(session.scene().accel->packet_width()) : "off"},
                {"pathtracer:caustic_light_paths", std::to_string(st.light_paths)},
                {"pathtracer:environment", p.env_map},
                {"pathtracer:threads", std::to_string(p.threads)},

@@ -17,7 +17,6 @@ struct CliOptions {
   bool version = false;    // --version
   bool spp_given = false;  // -s was on the command line (hints and the error target read it)
   bool quiet = false;      // --quiet: no progress bar
-  std::string script;      // --script: window input replayed from a file (tests)
   std::string output_dir;  // --output-dir: where the window's S and D keys write (empty: the current directory)
   bool describe = false;   // --describe: print the feature set and memory, no render
   std::string error_log;   // --error-log: CSV of the error per pass

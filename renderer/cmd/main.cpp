@@ -1,5 +1,6 @@
-// The pathtracer command: course flags -> load scene -> render -> write images -> summary line;
-// without -f, the debug window (viewer.cpp).
+// The pathtracer command's body: course flags -> load scene -> render -> write images -> summary
+// line; without -f, the debug window (viewer.cpp). Its mains: renderer/cmd/pathtracer.cpp, and the
+// test build's with the window's script player (tests/pathtracer_scripted.cpp).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -13,7 +14,6 @@
 
 #include "cli.h"
 #include "scene_file.h"
-#include "diffuse_lanes.h"
 #include "hints.h"
 #include "progress.h"
 #include "render_job.h"
@@ -60,15 +60,8 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
               f.bits == kFeatAll ? "" : ((f.bits & kFeatDelta) ? " delta" : " no-delta"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatMicrofacet) ? " microfacet" : " no-microfacet"),
               f.bits == kFeatAll ? "" : ((f.bits & kFeatInfinite) ? " infinite-lights" : " no-infinite-lights"));
-  const bool packets = packets_apply(scene, o.params);
-  if (packets) std::printf("ray queries:      paths in Embree packets of %d\n", scene.accel->packet_width());
+  if (packets_apply(o.params)) std::printf("ray queries:      paths in Embree packets of %d\n", scene.accel->packet_width());
   else std::printf("ray queries:      one path at a time\n");
-  const char* diffuse = !(packets && diffuse_lanes_apply(scene, PathSettings(o.params))) ? "one at a time"
-                        : lanes::lane_width() == 8                        ? "eight at a time (AVX2 lanes)"
-                                                                          : "four at a time (SSE2 lanes)";
-  std::printf("diffuse vertices: %s\n", diffuse);
-  std::printf("sample draws:     %s\n",
-              packets && sobol_draws_in_lanes(scene, o.params) ? "eight at a time (AVX2 lanes)" : "one at a time");
   std::printf("render memory:    %.2f MiB (%.1f bytes per primitive: BVH, vertices, indices, shading data)\n",
               bytes / 1048576.0, prims ? double(bytes) / prims : 0.0);
   std::printf("load + build:     %.3f s\n", load_s);
@@ -77,8 +70,7 @@ int describe_scene(const CliOptions& o, const SceneDesc& desc, const RenderScene
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
+int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0, viewer::WindowScript* script) {
   CliOptions o;
   try {
     o = parse_cli(args);
@@ -87,15 +79,15 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (o.help) {
-    std::printf("%s", usage_text(argv[0]).c_str());
+    std::printf("%s", usage_text(argv0).c_str());
     return 0;
   }
   if (o.version) {
     std::printf("%s\n", version_text("pathtracer").c_str());
     return 0;
   }
-  if (o.output.empty() && !o.describe) return run_viewer(o);
-  if (!o.script.empty()) {
+  if (o.output.empty() && !o.describe) return run_viewer(o, script);
+  if (script) {
     std::fprintf(stderr, "pathtracer: --script drives the window; it cannot be used with -f\n");
     return 1;
   }

@@ -123,12 +123,18 @@ Camera view_camera(const SceneDesc& desc, const RenderParams& p, const ViewPose&
   return view.moved ? camera_looking(c, view.position, view.target) : c;
 }
 
+std::unique_ptr<RenderScene> RenderLoop::make_scene(const RenderParams& p, const ViewPose& view) {
+  auto scene = make_view(m_base, p, m_environment);
+  m_environment = scene->environment;
+  if (view.moved) scene->camera = view_camera(m_desc, p, view);
+  return scene;
+}
+
 void RenderLoop::start_session(const RenderParams& p, const ViewPose& view, uint64_t gen) {
   m_driver.reset();
   m_session.reset();
-  m_scene.camera = view_camera(m_desc, p, view);
-  m_driver.reset();
-  m_session = std::make_unique<RenderSession>(m_scene, p);
+  m_scene = make_scene(p, view);
+  m_session = std::make_unique<RenderSession>(*m_scene, p);
   m_driver = std::make_unique<ProgressiveDriver>(*m_session, m_options.limits);
   m_estimate = ProgressEstimate(m_options.limits);
   m_params = p;
@@ -171,10 +177,7 @@ void RenderLoop::send_tile(uint64_t gen, const RenderSession& s, const Tile& t) 
 float RenderLoop::handle(const Command& c, const RenderParams& want, const ViewPose& view) {
   if (c.kind == CommandKind::focus) {
     // The pinhole ray of the camera the window shows now (pose and size; lens settings do not matter).
-    Camera current = m_scene.camera;
-    m_scene.camera = view_camera(m_desc, want, view);
-    float d = autofocus_distance(m_scene, c.sx, c.sy);
-    m_scene.camera = current;
+    float d = autofocus_distance(*make_scene(want, view), c.sx, c.sy);
     if (std::isfinite(d))
       say("autofocus (%.4f, %.4f): focal distance %s", c.sx, c.sy, fmt_g(d).c_str());
     else

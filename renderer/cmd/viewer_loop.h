@@ -94,14 +94,17 @@ struct Shared {
 
 class RenderLoop {
  public:
-  RenderLoop(const CliOptions& o, const SceneDesc& desc, RenderScene& scene, Shared& sh)
-      : m_options(o), m_desc(desc), m_scene(scene), m_sh(sh) {}
+  RenderLoop(const CliOptions& o, const SceneDesc& desc, const SceneBase& base, Shared& sh)
+      : m_options(o), m_desc(desc), m_base(base), m_sh(sh) {}
   // Renders until Shared::quit; an exception ends it with Shared::fatal set.
   void run();
 
  private:
   void loop();
   void start_session(const RenderParams& p, const ViewPose& view, uint64_t gen);
+  // The render scene for settings p and the pose: a view of the base (make_view, as a job's) with
+  // view_camera's camera.
+  std::unique_ptr<RenderScene> make_scene(const RenderParams& p, const ViewPose& view);
   // Runs on a worker thread right after the tile is finished for this pass.
   void send_tile(uint64_t gen, const RenderSession& s, const Tile& t);
   // Runs between passes (the pass was cancelled to get here; it resumes where it stopped).
@@ -110,8 +113,10 @@ class RenderLoop {
 
   const CliOptions& m_options;
   const SceneDesc& m_desc;
-  RenderScene& m_scene;  // its camera is rebuilt for each session; only this thread touches it
+  const SceneBase& m_base;
   Shared& m_sh;
+  std::shared_ptr<const EnvironmentMap> m_environment;  // -e's map, read once for every session
+  std::unique_ptr<RenderScene> m_scene;  // the session's view of the base
   std::unique_ptr<RenderSession> m_session;
   std::unique_ptr<ProgressiveDriver> m_driver;  // the session's passes and stop rules
   ProgressEstimate m_estimate;

@@ -3,11 +3,15 @@
 
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+
+#include "viewer_loop.h"
 
 namespace pt {
 namespace viewer {
@@ -67,6 +71,67 @@ std::vector<ScriptLine> load_script(const std::string& path) {
     out.push_back(std::move(l));
   }
   return out;
+}
+
+namespace {
+constexpr double kTimeoutMs = 120000;  // a wait that never ends fails the run
+}
+
+void ScriptPlayer::step(ScriptHost& host) {
+  using Clock = std::chrono::steady_clock;
+  auto ms = [this] { return std::chrono::duration<double, std::milli>(Clock::now() - m_started_at).count(); };
+  while (m_pos < m_lines.size()) {
+    const ScriptLine& l = m_lines[m_pos];
+    const std::string& c = l.words[0];
+    auto arg = [&](int i) { return std::strtod(l.words[i].c_str(), nullptr); };
+    if (!m_started) {
+      m_started = true;
+      m_started_at = Clock::now();
+      if (c == "resize") host.request_size(int(arg(1)), int(arg(2)));
+    }
+    bool done = true;
+    if (c == "wait_spp") {
+      done = host.reached(arg(1));
+    } else if (c == "wait_ms") {
+      done = ms() >= arg(1);
+    } else if (c == "sync") {
+      done = host.synced();
+      if (done) say("sync: %.0f ms", ms());
+    } else if (c == "resize") {
+      done = host.rendering_at(int(arg(1)), int(arg(2)));
+    } else if (c == "key") {
+      host.key(key_code(l.words[1]));
+    } else if (c == "click") {
+      host.click(arg(1), arg(2));
+    } else if (c == "drag") {  // press, STEPS moves along the line, release: as a hand would
+      const int steps = std::max(1, int(arg(6)));
+      const bool left = l.words[1] == "left";
+      host.button(left, true, arg(2), arg(3));
+      for (int k = 1; k <= steps; ++k)
+        host.cursor(arg(2) + (arg(4) - arg(2)) * k / steps, arg(3) + (arg(5) - arg(3)) * k / steps);
+      host.button(left, false, arg(4), arg(5));
+    } else if (c == "wheel") {
+      host.wheel(arg(1));
+    } else if (c == "title") {
+      say("title: %s", host.title().c_str());
+    } else if (c == "overlay") {
+      host.report_overlay();
+    } else if (c == "screenshot") {
+      host.screenshot(l.words[1]);
+    } else if (c == "close" || c == "quit") {
+      host.close(0);
+    }
+    if (!done) {
+      if (ms() > kTimeoutMs) {
+        std::fprintf(stderr, "pathtracer: %s:%d: '%s' timed out\n", m_path.c_str(), l.line, c.c_str());
+        host.close(1);
+      }
+      return;
+    }
+    ++m_pos;
+    m_started = false;
+    if (c == "close" || c == "quit") return;
+  }
 }
 
 }  // namespace viewer

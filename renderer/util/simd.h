@@ -10,12 +10,6 @@ inline bool avx2_available() {
   return avx2;
 }
 
-// The AVX2 code paths (diffuse lanes, camera rays) run where the CPU has AVX2 and this allows them:
-// tests turn them off to check the SSE2 paths on AVX2 machines.
-inline bool g_allow_avx2 = true;
-inline void allow_avx2(bool allow) { g_allow_avx2 = allow; }
-inline bool use_avx2() { return g_allow_avx2 && avx2_available(); }
-
 }  // namespace pt::simd
 
 // Code between these is compiled for AVX2: a target pragma for GCC, an attribute pragma for clang
