@@ -42,6 +42,10 @@ class PassSource {
   // Nothing left to render: every pixel done (gathered: also every pass asked for merged).
   virtual bool finished() const { return film().finished(); }
   virtual RenderCounts counts() const = 0;
+  // Whether a checkpoint now would keep anything: a session always (even a film cancelled before
+  // its first sample is a render that can be continued); the scale-out server not before its first
+  // merged pass, whose worker names the scene's features.
+  virtual bool anything_to_keep() const { return true; }
   // The tiles on_tile reports, covering the film: what a front end republishes in full.
   virtual const std::vector<Tile>& tiles() const = 0;
   // Checkpoints (checkpoint.h): everything the render has taken, its film included. save() between

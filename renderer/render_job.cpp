@@ -5,10 +5,10 @@ namespace pt {
 
 namespace {
 
-// A checkpoint between passes (or `force`d at the end); none before the first sample.
+// A checkpoint between passes (or `force`d at the end), where the source has anything to keep.
 void checkpoint(Checkpointer* checkpoints, const PassSource& source, const ProgressiveDriver& driver, bool force,
                 const RenderJobEvents& events) {
-  if (!checkpoints || source.counts().samples == 0) return;
+  if (!checkpoints || !source.anything_to_keep()) return;
   try {
     if (checkpoints->after_pass(source, driver, force) && events.checkpointed) events.checkpointed();
   } catch (const std::exception& e) {

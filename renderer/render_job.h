@@ -29,7 +29,7 @@ struct RenderJobEvents {
 // until the render ends or `stop` is set, checkpoints between passes at the checkpointer's
 // interval and always at the end (a cancel, a time limit or a restart resumes it exactly), and,
 // where a pass was cut short, reports every tile once more so that the last picture shown is the
-// final film. A checkpoint of nothing (no sample taken) is not written.
+// final film. A source with nothing to keep (PassSource::anything_to_keep) writes no checkpoint.
 StopReason run_render_job(PassSource& source, const RunLimits& limits, Checkpointer* checkpoints,
                           const std::atomic<bool>* stop, const RenderJobEvents& events);
 

@@ -156,6 +156,7 @@ class WorkerPasses : public pt::PassSource {
     return m_film.finished() || (m_plan.exhausted() && m_merged.size() == m_plan.issued());
   }
   pt::RenderCounts counts() const override { return {m_samples, m_rays, m_nonfinite}; }
+  bool anything_to_keep() const override { return m_started; }
   const std::vector<pt::Tile>& tiles() const override { return m_tiles; }
   // Checkpoints: the merged film, the passes issued and which of them were merged. A restored run
   // (a new run id) issues again the passes that were out when the server stopped.
