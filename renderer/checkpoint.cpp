@@ -81,6 +81,7 @@ std::string render_fingerprint(const std::string& scene_bytes, const RenderParam
   }
   f << ", sampler " << int(p.sampler) << ", environment '" << p.env_map << "', camera file '" << p.camera_file
     << "', cell " << p.cell_x << " " << p.cell_y << " " << p.cell_w << " " << p.cell_h;
+  if (p.features) f << ", denoising features";
   if (p.camera.set) {
     const CameraPose& c = p.camera;
     f.precision(9);  // a float's every digit: two poses a hair apart are two films

@@ -39,7 +39,7 @@ Vec3 rate_colour(uint32_t count, int spp) {
   return r <= 0.5f ? Vec3(0, 2 * r, 1 - 2 * r) : Vec3(2 * r - 1, 2 - 2 * r, 0);
 }
 
-Film::Film(int width, int height, int spp, const AdaptiveRule& rule, bool caustics)
+Film::Film(int width, int height, int spp, const AdaptiveRule& rule, bool caustics, bool features)
     : m_w(width), m_h(height), m_spp(spp), m_rule(rule) {
   m_rule.batch = std::max(1u, m_rule.batch);
   const size_t n = size_t(width) * size_t(height);
@@ -55,6 +55,12 @@ Film::Film(int width, int height, int spp, const AdaptiveRule& rule, bool causti
     assign_zeroed(m_lt_s1, n, 0.0);
     assign_zeroed(m_lt_half_s1, n, 0.0);
   }
+  if (features) {
+    assign_zeroed(m_albedo_sum, n, Vec3(0.0f));
+    assign_zeroed(m_normal_sum, n, Vec3(0.0f));
+    assign_zeroed(m_half_sum, n, Vec3(0.0f));
+    if (caustics) assign_zeroed(m_lt_half_sum, n, Vec3(0.0f));
+  }
 }
 
 uint32_t Film::add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stopped) {
@@ -64,6 +70,7 @@ uint32_t Film::add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stop
     if (to > 1 && last >= from) {
       m_half_s1[i] = m_s1[i];
       m_half_n[i] = last;
+      if (!m_half_sum.empty()) m_half_sum[i] = m_sum[i];
     }
     m_count[i] = to;
     return to - from;
@@ -73,6 +80,7 @@ uint32_t Film::add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stop
     if (s > 0 && (s & (s - 1)) == 0) {
       m_half_s1[i] = m_s1[i];
       m_half_n[i] = s;
+      if (!m_half_sum.empty()) m_half_sum[i] = m_sum[i];
     }
     const uint32_t n = ++s;
     if (m_rule.test_due(n) && m_rule.converged(m_s1[i], m_s2[i], n)) {
@@ -136,6 +144,7 @@ void Film::begin_light_paths() {
   if (m_lt_paths > 0 && m_lt_paths >= 2 * m_lt_half_paths) {
     m_lt_half_s1 = m_lt_s1;
     m_lt_half_paths = m_lt_paths;
+    if (!m_lt_half_sum.empty()) m_lt_half_sum = m_lt_sum;
   }
 }
 
@@ -160,18 +169,27 @@ void Film::merge(const FilmPass& pass) {
       m_lt_s1.assign(m_sum.size(), 0);
       m_lt_half_s1.assign(m_sum.size(), 0);
     }
+    if (has_features() && m_lt_half_sum.empty()) m_lt_half_sum.assign(m_sum.size(), Vec3(0.0f));
     for (size_t i = 0; i < m_lt_sum.size(); ++i) {
       m_lt_sum[i] += pass.caustic_sum[i];
       double l = luminance(pass.caustic_sum[i]);
       m_lt_s1[i] += l;
       if (to_half) m_lt_half_s1[i] += l;
+      if (to_half && !m_lt_half_sum.empty()) m_lt_half_sum[i] += pass.caustic_sum[i];
     }
     m_lt_paths += pass.light_paths;
     if (to_half) m_lt_half_paths += pass.light_paths;
   }
+  // Features: a film that has them takes them from every pass (a pass without them adds none).
+  const bool features = has_features() && pass.albedo_sum.size() == m_sum.size() && pass.normal_sum.size() == m_sum.size();
   for (size_t i = 0; i < m_sum.size(); ++i) {
     uint32_t c = pass.samples[i];
     if (c == 0) continue;
+    if (features) {
+      m_albedo_sum[i] += pass.albedo_sum[i];
+      m_normal_sum[i] += pass.normal_sum[i];
+      if (to_half) m_half_sum[i] += pass.sum[i];
+    }
     double s1 = luminance(pass.sum[i]);
     m_sum[i] += pass.sum[i];
     m_s1[i] += s1;
@@ -198,21 +216,31 @@ FilmPass Film::to_pass(uint32_t first, uint32_t count) const {
   out.samples = m_count;
   out.caustic_sum = m_lt_sum;
   out.light_paths = m_lt_paths;
+  out.albedo_sum = m_albedo_sum;
+  out.normal_sum = m_normal_sum;
   return out;
 }
 
 void Film::save(BinaryWriter& out) const {
-  out.pod(int32_t(m_w)), out.pod(int32_t(m_h)), out.pod(int32_t(m_spp)), out.pod(uint8_t(has_caustics()));
+  // Bit 0: caustic sums; bit 1: features (a film saved before features existed reads as without).
+  out.pod(int32_t(m_w)), out.pod(int32_t(m_h)), out.pod(int32_t(m_spp)),
+      out.pod(uint8_t((has_caustics() ? 1 : 0) | (has_features() ? 2 : 0)));
   out.array(m_sum), out.array(m_s1), out.array(m_s2), out.array(m_half_s1), out.array(m_half_n);
   out.array(m_count), out.array(m_done);
   out.pod(m_half_samples), out.pod(m_other_samples);
   out.array(m_lt_sum), out.array(m_lt_s1), out.array(m_lt_half_s1);
   out.pod(m_lt_paths), out.pod(m_lt_half_paths);
+  if (has_features()) out.array(m_albedo_sum), out.array(m_normal_sum), out.array(m_half_sum), out.array(m_lt_half_sum);
 }
 
 void Film::restore(BinaryReader& in) {
   const int32_t w = in.pod<int32_t>(), h = in.pod<int32_t>(), spp = in.pod<int32_t>();
-  const bool caustics = in.pod<uint8_t>() != 0;
+  const uint8_t flags = in.pod<uint8_t>();
+  const bool caustics = (flags & 1) != 0, features = (flags & 2) != 0;
+  if (flags > 3) in.fail("unknown film flags " + std::to_string(flags));
+  if (features != has_features())
+    in.fail(features ? "a film with the denoiser's features (this render has none)"
+                     : "a film without the denoiser's features (this render needs them)");
   // Splat sums come with the film: a merged film gains them with its first pass that has some.
   if (w != m_w || h != m_h) in.fail("a " + std::to_string(w) + "x" + std::to_string(h) + " film");
   if (spp < 1 || spp > m_spp)
@@ -224,6 +252,14 @@ void Film::restore(BinaryReader& in) {
   m_half_samples = in.pod<uint64_t>(), m_other_samples = in.pod<uint64_t>();
   in.array(m_lt_sum, lt), in.array(m_lt_s1, lt), in.array(m_lt_half_s1, lt);
   m_lt_paths = in.pod<uint64_t>(), m_lt_half_paths = in.pod<uint64_t>();
+  if (features) {
+    in.array(m_albedo_sum, n), in.array(m_normal_sum, n), in.array(m_half_sum, n);
+    in.array(m_lt_half_sum, caustics ? n : 0);
+    for (size_t i = 0; i < n; ++i)
+      if (!is_finite(m_albedo_sum[i]) || !is_finite(m_normal_sum[i]) || !is_finite(m_half_sum[i]) ||
+          (caustics && !is_finite(m_lt_half_sum[i])))
+        in.fail("pixel " + std::to_string(i) + " holds impossible features");
+  }
   for (size_t i = 0; i < n; ++i)
     if (m_count[i] > uint32_t(spp) || m_half_n[i] > m_count[i] || m_done[i] > 1 || !is_finite(m_sum[i]) ||
         !std::isfinite(m_s1[i]) || !std::isfinite(m_s2[i]) || !std::isfinite(m_half_s1[i]) ||
@@ -250,6 +286,47 @@ ImageRGB Film::rate_image() const {
 ImageRGB Film::caustic_image() const {
   if (m_lt_paths == 0) return make_image(m_w, m_h, [](size_t) { return Vec3(0.0f); });
   return make_image(m_w, m_h, [this](size_t i) { return m_lt_sum[i] / float(m_lt_paths); });
+}
+
+FilmFeatures Film::features() const {
+  FilmFeatures f;
+  const bool any = has_features();
+  f.albedo = make_image(m_w, m_h, [&](size_t i) { return any && m_count[i] ? m_albedo_sum[i] / float(m_count[i]) : Vec3(0.0f); });
+  f.normal = make_image(m_w, m_h, [&](size_t i) { return any && m_count[i] ? m_normal_sum[i] / float(m_count[i]) : Vec3(0.0f); });
+  return f;
+}
+
+bool Film::part_images(ImageRGB& first, ImageRGB& rest) const {
+  if (!has_features()) return false;
+  bool any = false;
+  // The splats' parts: their first part's paths, and the rest (each part's mean over its own paths).
+  const uint64_t lt_a = m_lt_half_paths, lt_b = m_lt_paths - m_lt_half_paths;
+  const bool splats = !m_lt_half_sum.empty() && lt_a > 0 && lt_b > 0;
+  first = make_image(m_w, m_h, [&](size_t i) {
+    const uint32_t p = m_half_n[i];
+    any |= p > 0 && p < m_count[i];
+    Vec3 v = p ? m_half_sum[i] / float(p) : Vec3(0.0f);
+    if (splats) v += m_lt_half_sum[i] / float(lt_a);
+    else if (m_lt_paths > 0) v += m_lt_sum[i] / float(m_lt_paths);
+    return v;
+  });
+  rest = make_image(m_w, m_h, [&](size_t i) {
+    const uint32_t p = m_half_n[i], n = m_count[i];
+    Vec3 v = n > p ? (m_sum[i] - m_half_sum[i]) / float(n - p) : Vec3(0.0f);
+    if (splats) v += (m_lt_sum[i] - m_lt_half_sum[i]) / float(lt_b);
+    else if (m_lt_paths > 0) v += m_lt_sum[i] / float(m_lt_paths);
+    return v;
+  });
+  return any;
+}
+
+std::vector<float> Film::part_weights() const {
+  std::vector<float> w(m_count.size(), 0.0f);
+  for (size_t i = 0; i < w.size(); ++i) {
+    const double n = m_count[i], p = m_half_n[i];
+    if (p > 0 && p < n) w[i] = float(p * (n - p) / (n * n));
+  }
+  return w;
 }
 
 void Film::read_tile(const Tile& t, std::vector<Vec3>& out) const {

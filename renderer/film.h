@@ -127,10 +127,17 @@ double halves_error_estimate(int width, const std::vector<uint32_t>& count, cons
 // infinite (before any pixel has two samples). The CSV log keeps "inf", which parsers read.
 std::string format_error_estimate(double error);
 
+// What the denoiser reads of a film beside its image (denoiser.h): per-pixel mean albedo and
+// normal, and the image of each of the error estimate's two parts of the samples.
+struct FilmFeatures {
+  ImageRGB albedo, normal;
+};
+
 class Film {
  public:
-  // A width x height film for `spp` samples a pixel; `caustics`: it also sums light-traced splats.
-  Film(int width, int height, int spp, const AdaptiveRule& rule, bool caustics);
+  // A width x height film for `spp` samples a pixel; `caustics`: it also sums light-traced splats;
+  // `features`: it also sums the denoiser's features and keeps the colour of its first part.
+  Film(int width, int height, int spp, const AdaptiveRule& rule, bool caustics, bool features = false);
 
   int width() const { return m_w; }
   int height() const { return m_h; }
@@ -149,6 +156,7 @@ class Film {
     if (s > 0 && (s & (s - 1)) == 0) {  // s samples so far, a power of two: keep their sum
       m_half_s1[i] = m_s1[i];
       m_half_n[i] = s;
+      if (!m_half_sum.empty()) m_half_sum[i] = m_sum[i];
     }
     m_sum[i] += l;
     double lum = luminance(l);
@@ -160,6 +168,12 @@ class Film {
   // Black samples [from, to) of pixel i (it sees only background): add_sample with l = 0 for each.
   // Stops after the first adaptive test that passes (then `stopped`); returns the samples added.
   uint32_t add_zero_samples(size_t i, uint32_t from, uint32_t to, bool& stopped);
+  // The denoiser's features of one sample of pixel i (with its add_sample); non-finite ones count as 0.
+  void add_features(size_t i, Vec3 albedo, Vec3 normal) {
+    m_albedo_sum[i] += is_finite(albedo) ? albedo : Vec3(0.0f);
+    m_normal_sum[i] += is_finite(normal) ? normal : Vec3(0.0f);
+  }
+  bool has_features() const { return !m_albedo_sum.empty(); }
   uint32_t count(size_t i) const { return m_count[i]; }
   bool done(size_t i) const { return m_done[i] != 0; }
   void set_done(size_t i) { m_done[i] = 1; }
@@ -218,6 +232,14 @@ class Film {
   ImageRGB image() const;
   ImageRGB rate_image() const;     // the course's sample-rate colouring
   ImageRGB caustic_image() const;  // the light-traced caustics alone; black without them
+  // The mean albedo and normal (has_features(); black images otherwise).
+  FilmFeatures features() const;
+  // The images of the error estimate's two parts of each pixel's samples (has_features()): false
+  // until some pixel has both.
+  bool part_images(ImageRGB& first, ImageRGB& rest) const;
+  // Per pixel, the weight p (n - p) / n^2 that turns the squared difference of the two parts'
+  // means into the variance of the whole mean (halves_error_estimate); 0 where a part is empty.
+  std::vector<float> part_weights() const;
   // Mean radiance / rate colours of a tile's pixels, row by row. Safe while other tiles render.
   void read_tile(const Tile& t, std::vector<Vec3>& out) const;
   void read_tile_rate(const Tile& t, std::vector<Vec3>& out) const;
@@ -245,6 +267,8 @@ class Film {
   std::vector<Vec3> m_lt_sum;
   std::vector<double> m_lt_s1, m_lt_half_s1;
   uint64_t m_lt_paths = 0, m_lt_half_paths = 0;
+  // With features: albedo and normal sums, and the first part's colour sum (and splat sum).
+  std::vector<Vec3> m_albedo_sum, m_normal_sum, m_half_sum, m_lt_half_sum;
   CachedEstimate m_estimate;
 };
 

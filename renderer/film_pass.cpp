@@ -17,7 +17,8 @@ struct Header {
   uint64_t rays, nonfinite;
   double seconds;
   uint64_t light_paths;
-  uint32_t has_caustics, unused;  // caustic sums follow the sample counts
+  uint32_t has_caustics;  // caustic sums follow the sample counts
+  uint32_t has_features;  // then albedo and normal sums (a pass from before features: 0 here)
 };
 
 template <class T>
@@ -49,12 +50,13 @@ std::string FilmPass::encode() const {
   h.seconds = seconds;
   h.light_paths = light_paths;
   h.has_caustics = caustic_sum.empty() ? 0 : 1;
-  h.unused = 0;
+  h.has_features = albedo_sum.empty() ? 0 : 1;
   std::string out(reinterpret_cast<const char*>(&h), sizeof h);
   append(out, sum);
   append(out, lum2);
   append(out, samples);
   append(out, caustic_sum);
+  if (h.has_features) append(out, albedo_sum), append(out, normal_sum);
   return out;
 }
 
@@ -64,11 +66,13 @@ FilmPass FilmPass::decode(const std::string& bytes, int expect_width, int expect
   std::memcpy(&h, bytes.data(), sizeof h);
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) throw std::runtime_error("film pass: not a PTFILM2 buffer");
   if (h.has_caustics > 1) throw std::runtime_error("film pass: bad caustics flag");
+  if (h.has_features > 1) throw std::runtime_error("film pass: bad features flag");
   if (int(h.width) != expect_width || int(h.height) != expect_height)
     throw std::runtime_error("film pass: " + std::to_string(h.width) + "x" + std::to_string(h.height) + " film, expected " +
                              std::to_string(expect_width) + "x" + std::to_string(expect_height));
   size_t n = size_t(h.width) * h.height;
-  if (bytes.size() != sizeof h + n * (sizeof(Vec3) + sizeof(float) + sizeof(uint32_t) + h.has_caustics * sizeof(Vec3)))
+  if (bytes.size() != sizeof h + n * (sizeof(Vec3) + sizeof(float) + sizeof(uint32_t) + h.has_caustics * sizeof(Vec3) +
+                                      h.has_features * 2 * sizeof(Vec3)))
     throw std::runtime_error("film pass: " + std::to_string(bytes.size()) + " bytes does not match a " +
                              std::to_string(h.width) + "x" + std::to_string(h.height) + " film");
   FilmPass p;
@@ -85,9 +89,18 @@ FilmPass FilmPass::decode(const std::string& bytes, int expect_width, int expect
   extract(bytes, at, p.lum2, n);
   extract(bytes, at, p.samples, n);
   if (h.has_caustics) extract(bytes, at, p.caustic_sum, n);
+  if (h.has_features) extract(bytes, at, p.albedo_sum, n), extract(bytes, at, p.normal_sum, n);
+  // A feature mean is in [0, 1] (albedo) or [-1, 1] (normal): a sum beyond its samples is forged.
+  auto feature_ok = [&](size_t i) {
+    if (!h.has_features) return true;
+    const Vec3 a = p.albedo_sum[i], nn = p.normal_sum[i];
+    const float c = float(p.samples[i]) * 1.0001f + 1e-3f;
+    return is_finite(a) && is_finite(nn) && std::fabs(a.x) <= c && std::fabs(a.y) <= c && std::fabs(a.z) <= c &&
+           std::fabs(nn.x) <= c && std::fabs(nn.y) <= c && std::fabs(nn.z) <= c;
+  };
   for (size_t i = 0; i < n; ++i)
     if (p.samples[i] > p.count || !is_finite(p.sum[i]) || !std::isfinite(p.lum2[i]) ||
-        (h.has_caustics && !is_finite(p.caustic_sum[i])))
+        (h.has_caustics && !is_finite(p.caustic_sum[i])) || !feature_ok(i))
       throw std::runtime_error("film pass: pixel " + std::to_string(i) + " holds impossible values");
   return p;
 }

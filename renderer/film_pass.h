@@ -22,6 +22,9 @@ struct FilmPass {
   // share of them; empty when the job renders caustics by path tracing alone.
   std::vector<Vec3> caustic_sum;
   uint64_t light_paths = 0;
+  // The denoiser's features (Film::add_features): albedo and normal sums per pixel; empty when
+  // the job is not denoised.
+  std::vector<Vec3> albedo_sum, normal_sum;
   uint64_t rays = 0, nonfinite = 0;
   double seconds = 0;
 

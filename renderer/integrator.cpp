@@ -13,8 +13,9 @@ using namespace path_loop;
 
 // One path at a time: every ray query answered at once.
 template <uint32_t F>
-Vec3 trace_path_t(const RenderScene& scene, const PathSettings& settings, Ray ray, Sampler& rng, uint64_t& rays) {
-  PathState st(ray, settings.max_depth);
+Vec3 trace_path_t(const RenderScene& scene, const PathSettings& settings, Ray ray, Sampler& rng, PathFeatures* features,
+                  uint64_t& rays) {
+  PathState st(ray, settings.max_depth, features != nullptr);
   struct {  // each shadow ray traced at once
     const Accel& accel;
     PathState& st;
@@ -30,14 +31,17 @@ Vec3 trace_path_t(const RenderScene& scene, const PathSettings& settings, Ray ra
     bool found = scene.accel->intersect(st.ray, hit, st.bounce == 0);
     bool more = path_step<F>(scene, settings, st, found, hit, rng, rays, shadow);
     st.resolve_direct();
-    if (!more) return st.radiance;
+    if (more) continue;
+    if (features) *features = {st.albedo, st.normal};
+    return st.radiance;
   }
 }
 
 template <uint32_t F>
 void trace_paths_one_by_one(const RenderScene& scene, const PathSettings& settings, const Ray* camera_rays,
-                            Sampler* rngs, size_t n, Vec3* out, uint64_t& rays) {
-  for (size_t i = 0; i < n; ++i) out[i] = trace_path_t<F>(scene, settings, camera_rays[i], rngs[i], rays);
+                            Sampler* rngs, size_t n, Vec3* out, PathFeatures* features, uint64_t& rays) {
+  for (size_t i = 0; i < n; ++i)
+    out[i] = trace_path_t<F>(scene, settings, camera_rays[i], rngs[i], features ? features + i : nullptr, rays);
 }
 
 }  // namespace

@@ -11,12 +11,17 @@
 
 namespace pt {
 
+// A path's features for the denoiser (PathState::albedo, normal).
+struct PathFeatures {
+  Vec3 albedo, normal;
+};
+
 // Camera paths' radiance, by the path loop specialised for a set of feature bits (one
 // instantiation per combination): traces camera_rays[0, n) with samplers rngs[0, n) (each already
-// past its pixel and lens draws) and writes each path's radiance to out[i]. `rays` counts every
-// ray cast.
+// past its pixel and lens draws) and writes each path's radiance to out[i], and its features to
+// features[i] unless `features` is null. `rays` counts every ray cast.
 using PathTracer = void (*)(const RenderScene&, const PathSettings&, const Ray* camera_rays, class Sampler* rngs,
-                            size_t n, Vec3* out, uint64_t& rays);
+                            size_t n, Vec3* out, PathFeatures* features, uint64_t& rays);
 // The tracer the session runs: the paths in a pool whose rays go to Embree in packets
 // (Accel::intersect_many; path_pool.cpp) where `packets` and the settings allow it, else one path
 // after another, each ray query answered at once (integrator.cpp).

@@ -2,6 +2,8 @@
 // Frame conventions are in materials.h.
 #include "materials.h"
 
+#include <algorithm>
+
 #include "pbr.h"
 #include "sampling.h"
 
@@ -27,6 +29,22 @@ bool is_delta(const Material& m) {
 bool is_transmissive(const Material& m) {
   return m.type == MaterialType::glass || m.type == MaterialType::refraction ||
          (m.type == MaterialType::pbr && (m.pbr.transmission > 0 || m.pbr.transmission_tex.used()));
+}
+
+Vec3 feature_albedo(const Material& m) {
+  Vec3 a;
+  switch (m.type) {
+    case MaterialType::microfacet: {  // F(0) = ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2)
+      auto f0 = [](float eta, float k) { return ((eta - 1) * (eta - 1) + k * k) / ((eta + 1) * (eta + 1) + k * k); };
+      a = Vec3(f0(m.eta.x, m.k.x), f0(m.eta.y, m.k.y), f0(m.eta.z, m.k.z));
+      break;
+    }
+    case MaterialType::emission: a = m.radiance; break;
+    case MaterialType::pbr: a = m.pbr.unlit ? m.pbr.emissive : m.pbr.base + m.pbr.emissive; break;  // a lamp: its light's colour
+    default: a = m.albedo;
+  }
+  auto unit = [](float v) { return v > 0 ? std::min(v, 1.0f) : 0.0f; };  // also NaN -> 0
+  return Vec3(unit(a.x), unit(a.y), unit(a.z));
 }
 
 bool is_emissive(const Material& m) {

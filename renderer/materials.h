@@ -49,6 +49,10 @@ bool sample_bsdf(const Material& m, Vec3 wo, float u_lobe, Vec2 u, BsdfSample& s
 // the back too for a double-sided glTF material).
 Vec3 emitted_radiance(const Material& m, Vec3 wo);
 bool is_emissive(const Material& m);
+// The denoiser's albedo feature of a non-delta material (Intel Open Image Denoise's "albedo"
+// image): its colour independent of light and view, in [0, 1]. Diffuse colour, a conductor's
+// normal-incidence Fresnel reflectance, a glTF material's base colour, an emitter's colour.
+Vec3 feature_albedo(const Material& m);
 
 // Fresnel reflectance of a dielectric interface for unpolarised light; cos_i on the side of
 // index eta_i. Returns 1 under total internal reflection.

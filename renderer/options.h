@@ -38,6 +38,9 @@ struct RenderParams {
   SamplerKind sampler = SamplerKind::sobol;  // --sampler: sobol (Owen-scrambled) or independent
   bool caustic_tracing = true;     // --no-caustic-tracing: caustics by light tracing where it applies
   bool default_light = true;       // --no-default-light: no default light for an unlit glTF scene
+  // The denoiser's albedo and normal sums beside the colour (--denoise, a job's denoise field): a
+  // render that is not denoised pays nothing for them.
+  bool features = false;
 
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;

@@ -81,6 +81,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
       continue;
     }
     v.ubx[j] = u[size_t(j)].x, v.uby[j] = u[size_t(j)].y;
+    if (st.want_features) st.set_features(albedo, dot(h.ns, st.ray.d) > 0 ? -h.ns : h.ns);
     v.roulette[j] = st.bounce >= kRouletteStart;
     v.urr[j] = v.roulette[j] ? samplers[size_t(j)]->next_float() : 0.0f;
     st.start_diffuse_vertex();
@@ -132,7 +133,7 @@ void diffuse_in_lanes(const RenderScene& scene, const PathSettings& settings, la
 // one. The same paths as the scalar loop, up to the packet kernel's rounding of a few hits.
 template <uint32_t F>
 void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const Ray* camera_rays, Sampler* rngs,
-                   size_t n, Vec3* out, uint64_t& rays) {
+                   size_t n, Vec3* out, PathFeatures* features, uint64_t& rays) {
   constexpr size_t kSlots = lanes::kMaxLanes;  // 64 to 4096 measured the same on CBdragon
   using Slot = PoolSlot;
   using Shadow = PendingShadow;
@@ -164,7 +165,7 @@ void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const
   size_t next = 0;
   for (;;) {
     for (; live < kSlots && next < n; ++live, ++next) {
-      slots[live].st.start(camera_rays[next], settings.max_depth);
+      slots[live].st.start(camera_rays[next], settings.max_depth, features != nullptr);
       slots[live].job = uint32_t(next);
     }
     if (live == 0) return;
@@ -215,8 +216,9 @@ void trace_paths_t(const RenderScene& scene, const PathSettings& settings, const
         continue;
       }
       out[slots[i].job] = slots[i].st.radiance;
+      if (features) features[slots[i].job] = {slots[i].st.albedo, slots[i].st.normal};
       if (next < n) {
-        slots[i].st.start(camera_rays[next], settings.max_depth);
+        slots[i].st.start(camera_rays[next], settings.max_depth, features != nullptr);
         slots[i].job = uint32_t(next++);
         ++i;
         continue;

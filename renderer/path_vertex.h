@@ -132,11 +132,18 @@ struct PathState {
   Vec3 prev_p;
   int depth_left;
   int bounce;
+  // The denoiser's features (denoiser.h) at the first vertex that is not a perfect mirror or glass,
+  // or where the path leaves the scene: its albedo (x the delta bounces' tint before it) and its
+  // shading normal turned to the viewer. Zero where the path ends before; `want_features` until set.
+  bool want_features;
+  Vec3 albedo, normal;
 
   PathState() { start(Ray(), 0); }
-  PathState(const Ray& camera_ray, int max_depth) { start(camera_ray, max_depth); }
+  PathState(const Ray& camera_ray, int max_depth, bool features = false) { start(camera_ray, max_depth, features); }
   // Every field set in place (a pool slot takes its next path here; see spawn_ray in accel.h).
-  void start(const Ray& camera_ray, int max_depth) {
+  void start(const Ray& camera_ray, int max_depth, bool features = false) {
+    want_features = features;
+    albedo = Vec3(0.0f), normal = Vec3(0.0f);
     ray = camera_ray;
     radiance = Vec3(0.0f), beta = Vec3(1.0f);
     direct_beta = Vec3(0.0f), direct_sum = Vec3(0.0f);
@@ -151,6 +158,11 @@ struct PathState {
   // A diffuse vertex's start and its bounce, as the lanes' text takes them at any width: its light
   // sampling weighed by the throughput it arrived with, then the bounce's bookkeeping (vertex
   // number `bounce`, its pdf, at point p).
+  void set_features(Vec3 surface_albedo, Vec3 facing_normal) {
+    const Vec3 tint = min(beta, Vec3(1.0f));  // the delta bounces' colour so far
+    albedo = surface_albedo * tint, normal = facing_normal;
+    want_features = false;
+  }
   void start_diffuse_vertex() {
     has_direct = true;
     direct_beta = beta;
@@ -181,6 +193,12 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
                Sampler& rng, uint64_t& rays, ShadowSink& shadow) {
   const int bounce = st.bounce++;
   if (!found) {
+    if (st.want_features) {  // the background's colour, no normal (OIDN's convention for no surface)
+      Vec3 le(0.0f);
+      if constexpr ((F & kFeatInfinite) != 0)
+        if (scene.environment_light >= 0) le = infinite_light_radiance(scene.lights[scene.environment_light], st.ray.d);
+      st.set_features(min(le, Vec3(1.0f)), Vec3(0.0f));
+    }
     if constexpr ((F & kFeatInfinite) != 0) {
       for (int i : scene.infinite_lights) {
         const Light& light = scene.lights[i];
@@ -202,6 +220,8 @@ bool path_step(const RenderScene& scene, const PathSettings& settings, PathState
   if constexpr ((F & kFeatTexture) != 0) file_material = &material_at(scene, *file_material, hit, ns);  // used within this call
   const Material& material = *file_material;
   Vec3 wo_world = -st.ray.d;
+  if (st.want_features && !has_delta<F>(material))
+    st.set_features(feature_albedo(material), dot(ns, wo_world) < 0 ? -ns : ns);
   if constexpr ((F & kFeatTexture) != 0) {
     // KHR_materials_volume: the segment just travelled lay inside the mesh (Beer-Lambert).
     const Vec3 sigma = material.pbr.attenuation;

@@ -41,7 +41,8 @@ RenderSession::RenderSession(const RenderScene& scene, const RenderParams& param
       // the cell's bottom-left origin, as a top-left one
       m_frame_y0(params.cell_w > 0 ? params.height - (params.cell_y + params.cell_h) : 0),
       m_path(params, caustic_tracing_applies(scene, params)),
-      m_film(film_width(params), film_height(params), params.spp, adaptive_rule(params), m_path.caustics_light_traced) {
+      m_film(film_width(params), film_height(params), params.spp, adaptive_rule(params), m_path.caustics_light_traced,
+             params.features) {
   const int w = width(), h = height();
   if (m_path.caustics_light_traced) m_caustic_film = {params.width, params.height, m_frame_x0, m_frame_y0, w, h};
   m_tiles = tile_grid(w, h, params.tile_size);

@@ -42,6 +42,8 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
   static thread_local std::vector<Vec2> draws;
   static thread_local std::vector<Ray> camera_rays;
   static thread_local std::vector<Vec3> out;
+  static thread_local std::vector<PathFeatures> features;  // only where the film keeps them
+  const bool with_features = m_film.has_features();
   // The job arrays are written by index up to `njobs`: sized once per tile for a full batch plus
   // one pixel's samples, which push_back's capacity checks would otherwise test at every store.
   const size_t capacity = kJobs + size_t(std::max(target, 1));
@@ -79,8 +81,11 @@ void RenderSession::render_tile(const Tile& t, int target, const std::atomic<boo
     if (camera_rays.size() < n) camera_rays.resize(n);  // kept between flushes: no zeroing
     m_scene.camera.generate_rays(sensor_x.data(), sensor_y.data(), draws.data(), n, camera_rays.data());
     out.resize(n);
-    if (n) trace(m_scene, m_path, camera_rays.data(), rngs.data(), n, out.data(), rays);
+    if (with_features) features.resize(n);
+    if (n) trace(m_scene, m_path, camera_rays.data(), rngs.data(), n, out.data(), with_features ? features.data() : nullptr, rays);
     samples += n;
+    if (with_features)
+      for (size_t k = 0; k < n; ++k) m_film.add_features(jobs[k].pixel, features[k].albedo, features[k].normal);
     for (size_t k = 0; k < n; ++k)  // job k traced camera ray k
       if (m_film.add_sample(jobs[k].pixel, jobs[k].sample, out[k], nonfinite)) {
         m_film.set_done(jobs[k].pixel);

@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libcpp-httplib-dev nlohmann-json3-dev libglfw3-dev
   libgl1-mesa-dri  # the window's OpenGL without a GPU (Mesa's llvmpipe)
   libhiredis-dev  # render-worker's Redis client (the scale-out queue)
+  python3-pip  # fetches the denoiser, Intel Open Image Denoise, from PyPI (scripts/install-oidn.sh)
 )
 # ... and what the tests add.
 if [ "${1:-all}" != main ]; then
@@ -29,6 +30,7 @@ for p in "${packages[@]}"; do
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
+  bash "$(dirname "$0")/install-oidn.sh"
   exit 0
 fi
 echo "install-deps: installing ${missing[*]}"
@@ -36,3 +38,4 @@ SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 $SUDO apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+bash "$(dirname "$0")/install-oidn.sh"  # the denoiser: not packaged by Debian 12

@@ -135,7 +135,7 @@ class WorkerPasses : public pt::PassSource {
         m_scene_hash(rq::content_hash(scene_text)), m_spec_json(job_spec_to_json(job.spec).dump()),
         // the scene decides whether passes carry caustics; plan for the larger
         m_plan(m_params.spp, size_t(m_w) * m_h, m_params.caustic_tracing ? 32.0 : 20.0),
-        m_film(m_w, m_h, m_params.spp, pt::adaptive_rule(m_params), false) {
+        m_film(m_w, m_h, m_params.spp, pt::adaptive_rule(m_params), false, m_params.features) {
     m_tiles = pt::tile_grid(m_w, m_h, m_params.tile_size);
   }
   // However the render ends, workers learn the run is over.

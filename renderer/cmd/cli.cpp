@@ -143,6 +143,7 @@ CliOptions parse_cli(const std::vector<std::string>& args) {
       else throw UsageError("--sampler: '" + v + "' is not sobol or independent");
     }
     else if (a == "--describe") { o.describe = true; }
+    else if (a == "--denoise") { o.denoise = true; p.features = true; }
     else if (a == "--error-log") { need(a, 1); o.error_log = args[++i]; }
     else if (a == "--progress-log") { need(a, 1); o.progress_log = args[++i]; }
     else if (a == "--reference") { need(a, 1); o.reference = args[++i]; }
@@ -237,6 +238,10 @@ std::string usage_text(const std::string& program) {
 "  --camera <PX> <PY> <PZ> <TX> <TY> <TZ> <VFOV>  look from P at T (up +Y) with this vertical\n"
 "                  field of view in degrees (0: the framing's), as a job's camera field\n"
 "  --describe      print the scene's feature set and the memory it takes, then exit\n"
+"  --denoise       write the image denoised by Intel Open Image Denoise (its albedo and normal\n"
+"                  features are gathered beside the colour); an EXR also holds the raw colour\n"
+"                  and the features as layers raw, albedo and normal. The window: starts with\n"
+"                  the denoised view (key N toggles it)\n"
 "  --no-caustic-tracing  render caustics (light, mirror/glass, diffuse, eye) by path tracing alone\n"
 "  --no-default-light    no white environment for a glTF scene without lights or emitters\n"
 "  --sampler <sobol|independent>  per-sample numbers: Owen-scrambled Sobol (default) or independent\n"

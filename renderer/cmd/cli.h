@@ -19,6 +19,7 @@ struct CliOptions {
   bool quiet = false;      // --quiet: no progress bar
   std::string output_dir;  // --output-dir: where the window's S and D keys write (empty: the current directory)
   bool describe = false;   // --describe: print the feature set and memory, no render
+  bool denoise = false;    // --denoise: write the denoised image (Intel Open Image Denoise)
   std::string error_log;   // --error-log: CSV of the error per pass
   std::string progress_log;  // --progress-log: CSV of the progress bar's fraction and ETA
   std::string reference;   // --reference: true error against this image

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "cli.h"
+#include "film_denoise.h"
 #include "scene_file.h"
 #include "hints.h"
 #include "progress.h"
@@ -91,6 +92,10 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
     std::fprintf(stderr, "pathtracer: --script drives the window; it cannot be used with -f\n");
     return 1;
   }
+  if (o.denoise && !o.describe && !Denoiser::shared().available()) {  // before the render, not after it
+    std::fprintf(stderr, "pathtracer: --denoise: %s\n", Denoiser::shared().description().c_str());
+    return 1;
+  }
   std::string doing = "loading " + o.scene_path;  // what an out-of-memory message names
   try {
     if (!o.describe) check_image_output(o.output);  // before the render, not after it
@@ -125,7 +130,8 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
     if (!o.error_log.empty()) {
       log = std::fopen(o.error_log.c_str(), "w");
       if (!log) throw std::runtime_error(o.error_log + ": cannot write the error log");
-      std::fprintf(log, "seconds,spp,error_estimate%s\n", reference.pixels.empty() ? "" : ",rmse,rel_mse");
+      std::fprintf(log, "seconds,spp,error_estimate%s%s\n", reference.pixels.empty() ? "" : ",rmse,rel_mse",
+                   !o.denoise ? "" : reference.pixels.empty() ? ",denoise_seconds" : ",denoise_seconds,denoised_rel_mse");
     }
     ProgressBar bar("Rendering", !o.quiet);
     double pixels = double(session.width()) * session.height();
@@ -187,6 +193,11 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
         ImageRGB img = session.image();
         std::fprintf(log, ",%.6g,%.6g", rmse(img, reference), relative_mse(img, reference));
       }
+      if (o.denoise) {  // the image --denoise would write after this pass, and what it took
+        const DenoisedFilm d = denoise_film(session.film(), DenoiseQuality::final, o.params.threads, false);
+        std::fprintf(log, ",%.6g", d.seconds);
+        if (!reference.pixels.empty()) std::fprintf(log, ",%.6g", d.ok ? relative_mse(d.image, reference) : NAN);
+      }
       std::fprintf(log, "\n");
       std::fflush(log);
     };
@@ -197,7 +208,22 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
 
     Metadata meta = render_metadata(o, session);
     meta.push_back({"pathtracer:stopped", stop_reason_name(why)});
-    write_image(session.image(), o.output, meta);
+    DenoisedFilm denoised;
+    if (o.denoise) {
+      denoised = denoise_film(session.film(), DenoiseQuality::final, o.params.threads, true);
+      if (!denoised.ok)  // the raw render is still worth its file
+        std::fprintf(stderr, "pathtracer: warning: %s; writing the raw image\n", denoised.error.c_str());
+    }
+    if (denoised.ok) {
+      const ImageRGB raw = session.image();
+      const FilmFeatures features = session.film().features();
+      meta.push_back({"pathtracer:denoised", std::string("final, ") + Denoiser::shared().description()});
+      meta.push_back({"pathtracer:denoised_noise_estimate", format_error_estimate(denoised.noise)});
+      write_image(denoised.image, o.output, meta,
+                  {{"raw", &raw}, {"albedo", &features.albedo}, {"normal", &features.normal, true}});
+    } else {
+      write_image(session.image(), o.output, meta);
+    }
     write_image(session.rate_image(), rate_image_path(o.output));
 
     SessionStats st = session.stats();
@@ -207,9 +233,15 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
     if (checkpoints && checkpoints->saves() > 0)
       std::printf("%s: %d checkpoint%s written in %.3f s\n", o.checkpoint.c_str(), checkpoints->saves(),
                   checkpoints->saves() == 1 ? "" : "s", checkpoints->save_seconds());
-    std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %s%s%s\n",
+    // The estimate is the raw render's; the denoised image's is the spread of its denoised halves.
+    std::string denoise_text;
+    if (denoised.ok)
+      denoise_text = ", denoised in " + std::to_string(denoised.seconds).substr(0, 5) + " s (noise estimate " +
+                     format_error_estimate(denoised.noise) + " from its denoised halves, bias not included)";
+    std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %s%s%s%s\n",
                 o.output.c_str(), session.width(), session.height(), st.samples / pixels, o.params.spp, st.seconds,
-                st.samples / st.seconds, st.rays / st.seconds, err_text.c_str(),
+                st.samples / st.seconds, st.rays / st.seconds, (err_text + (o.denoise ? " (raw)" : "")).c_str(),
+                denoise_text.c_str(),
                 why == StopReason::finished ? "" : (std::string(", ") + stop_reason_name(why)).c_str(),
                 st.nonfinite ? (", " + std::to_string(st.nonfinite) + " non-finite samples dropped").c_str() : "");
     return 0;

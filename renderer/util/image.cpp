@@ -132,8 +132,11 @@ void write_png8(const std::vector<uint8_t>& rgb, int width, int height, const st
   module().write_rgb8(rgb, width, height, path, {});
 }
 
-void write_image(const ImageRGB& img, const std::string& path, const Metadata& meta) {
-  if (ends_with(path, ".exr")) module().write_exr(img, path, meta);
+void write_image(const ImageRGB& img, const std::string& path, const Metadata& meta, const ExrLayers& layers) {
+  for (const ExrLayer& l : layers)
+    if (!l.image || l.image->width != img.width || l.image->height != img.height)
+      throw std::invalid_argument(path + ": layer '" + l.name + "' is not the image's size");
+  if (ends_with(path, ".exr")) module().write_exr(img, layers, path, meta);
   else module().write_rgb8(to_srgb8_course(img), img.width, img.height, path, meta);
 }
 

@@ -31,6 +31,15 @@ ImageRGB make_image(int width, int height, PixelAt pixel) {
 
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 
+// An EXR file's further layer beside its RGB: "albedo" writes channels albedo.R, albedo.G, albedo.B
+// (OpenEXR's layer.channel naming; `xyz`: .X, .Y, .Z, for a normal).
+struct ExrLayer {
+  std::string name;
+  const ImageRGB* image;
+  bool xyz = false;
+};
+using ExrLayers = std::vector<ExrLayer>;
+
 // Relative MSE on luminance, mean of (a - ref)^2 / (ref^2 + eps): the error measure the renderer
 // estimates and the benchmarks report (eps keeps black pixels from dominating).
 constexpr double kRelMseEpsilon = 1e-2;
@@ -43,7 +52,8 @@ uint8_t tonemap_course(float v);
 std::vector<uint8_t> to_srgb8_course(const ImageRGB& img);
 // Writes PNG (course tone mapping, 8-bit) or EXR (linear float + metadata) by extension.
 // Writes go to a temporary file in the same directory, then rename: never a partial file.
-void write_image(const ImageRGB& img, const std::string& path, const Metadata& meta = {});
+// `layers` (each img's size) go into an EXR beside its RGB; a PNG leaves them out.
+void write_image(const ImageRGB& img, const std::string& path, const Metadata& meta = {}, const ExrLayers& layers = {});
 // Writes 8-bit RGB rows (top first) as PNG, atomically.
 void write_png8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path);
 // Encodes 8-bit RGB rows as PNG bytes in memory (for streaming tiles).

@@ -14,12 +14,12 @@
 namespace pt {
 
 // Bumped whenever the table below changes, so a stale module is refused by name, not called.
-constexpr uint32_t kImageModuleAbi = 5;
+constexpr uint32_t kImageModuleAbi = 6;
 
 struct ImageModule {
   uint32_t abi;
-  // Linear float EXR with metadata, written atomically (temp file, fsync, rename).
-  void (*write_exr)(const ImageRGB& img, const std::string& path, const Metadata& meta);
+  // Linear float EXR with metadata and further layers, written atomically (temp file, fsync, rename).
+  void (*write_exr)(const ImageRGB& img, const ExrLayers& layers, const std::string& path, const Metadata& meta);
   // 8-bit RGB rows (top first) in whatever format the extension names, written atomically.
   void (*write_rgb8)(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path,
                      const Metadata& meta);

@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
@@ -123,8 +124,29 @@ OIIO::ImageSpec exr_spec(const ImageRGB& img, const Metadata& meta) {
   return spec;
 }
 
-void write_exr(const ImageRGB& img, const std::string& path, const Metadata& meta) {
-  write_atomic(path, exr_spec(img, meta), OIIO::TypeDesc::FLOAT, img.pixels.data());
+void write_exr(const ImageRGB& img, const ExrLayers& unsorted, const std::string& path, const Metadata& meta) {
+  if (unsorted.empty()) return write_atomic(path, exr_spec(img, meta), OIIO::TypeDesc::FLOAT, img.pixels.data());
+  // In the order OpenImageIO reads them back (R, G, B, then the layers by name), which the
+  // verification compares against.
+  ExrLayers layers = unsorted;
+  std::stable_sort(layers.begin(), layers.end(), [](const ExrLayer& a, const ExrLayer& b) { return a.name < b.name; });
+  OIIO::ImageSpec spec = exr_spec(img, meta);
+  const size_t nc = 3 + 3 * layers.size(), n = img.pixels.size();
+  spec.nchannels = int(nc);
+  spec.channelnames = {"R", "G", "B"};
+  for (const ExrLayer& l : layers)
+    for (const char* c : l.xyz ? std::vector<const char*>{"X", "Y", "Z"} : std::vector<const char*>{"R", "G", "B"})
+      spec.channelnames.push_back(l.name + "." + c);
+  std::vector<float> data(n * nc);  // interleaved, pixel by pixel
+  for (size_t i = 0; i < n; ++i) {
+    float* px = &data[i * nc];
+    px[0] = img.pixels[i].x, px[1] = img.pixels[i].y, px[2] = img.pixels[i].z;
+    for (size_t k = 0; k < layers.size(); ++k) {
+      const Vec3 v = layers[k].image->pixels[i];
+      px[3 + 3 * k] = v.x, px[4 + 3 * k] = v.y, px[5 + 3 * k] = v.z;
+    }
+  }
+  write_atomic(path, spec, OIIO::TypeDesc::FLOAT, data.data());
 }
 
 void write_rgb8(const std::vector<uint8_t>& rgb, int width, int height, const std::string& path,
