@@ -187,6 +187,11 @@ Denoiser::Denoiser() : m_state(new State) {
 
 Denoiser::~Denoiser() = default;
 
+std::string Denoiser::summary() const {
+  if (m_api) return m_description.substr(0, m_description.find(" ("));
+  return "the denoiser (Intel Open Image Denoise) is not installed; scripts/install-oidn.sh installs it";
+}
+
 bool Denoiser::denoise(const ImageRGB& color, const ImageRGB& albedo, const ImageRGB& normal, DenoiseQuality quality,
                        int threads, ImageRGB& out, std::string& error) {
   if (!m_api) {

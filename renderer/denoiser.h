@@ -31,6 +31,9 @@ class Denoiser {
   bool available() const { return m_api != nullptr; }
   // "Intel Open Image Denoise 2.5.1 (path)", or why it is not available and how to get it.
   const std::string& description() const { return m_description; }
+  // The same without file paths, for clients of a server: "Intel Open Image Denoise 2.5.1", or
+  // that it is not installed and how its operator installs it.
+  std::string summary() const;
   int version() const { return m_version; }
 
   // Denoises `color` (linear HDR, finite, w x h) guided by `albedo` (in [0, 1]) and `normal` (in

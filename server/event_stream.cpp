@@ -31,6 +31,8 @@ struct Encodings {
   int image_png_width = 0, image_png_height = 0;
   uint64_t image_png_pass = ~uint64_t(0), image_png_version = 0;
   double image_png_time = 0;  // steady seconds when it was encoded
+  std::shared_ptr<const std::string> denoised_event;  // the SSE 'denoised' event, less its id
+  uint64_t denoised_event_version = 0;
   std::atomic<size_t> bytes{0};  // what the encodings above hold, about
 };
 
@@ -215,10 +217,37 @@ Snapshot snapshot_png(Job& job) {
   return s;
 }
 
+// The job's last denoised picture as an SSE 'denoised' event (less its id), encoded once for all
+// watchers; null when there is none newer than `after`.
+std::shared_ptr<const std::string> denoised_event(Job& job, Encodings& enc, uint64_t& after) {
+  std::lock_guard<std::mutex> encoding(enc.mutex);
+  std::vector<uint8_t> rgb;
+  json head;
+  uint64_t version;
+  int w = 0, h = 0;
+  {
+    std::lock_guard<std::mutex> lock(job.mutex);
+    const Job::Denoised& d = job.denoised;
+    if (d.version <= after || d.display.size() != size_t(job.width) * job.height * 3) return nullptr;
+    after = d.version;
+    if (enc.denoised_event && enc.denoised_event_version == d.version) return enc.denoised_event;
+    rgb = d.display;
+    version = d.version;
+    w = job.width, h = job.height;
+    head = {{"width", job.width}, {"height", job.height}, {"spp", d.spp}, {"final", d.final}, {"seconds", d.seconds}};
+  }
+  head["png"] = base64(encode_png(rgb, w, h));  // outside the render threads' mutex
+  const size_t before = enc.denoised_event ? enc.denoised_event->size() : 0;
+  enc.denoised_event = std::make_shared<const std::string>("event: denoised\ndata: " + dump_json(head) + "\n\n");
+  enc.bytes += enc.denoised_event->size() - before;
+  enc.denoised_event_version = version;
+  return enc.denoised_event;
+}
+
 void run_stream(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::DataSink& sink) {
   const std::shared_ptr<Encodings> encodings = encodings_for(*job);  // held for the stream's life
   std::vector<uint64_t> sent;
-  uint64_t seen = 0;
+  uint64_t seen = 0, denoised_sent = 0;
   bool first = true;
   // Watchers cost the renderer CPU: tiles are batched per round (a round at most every 40 ms) and
   // a status event goes out at most every 250 ms unless the state changes.
@@ -284,6 +313,9 @@ void run_stream(JobManager& jobs, const std::shared_ptr<Job>& job, httplib::Data
       if (!write(id) || !write(*event)) return;
       ++g_tile_events;
     }
+    // After the tiles: a denoised picture replaces the raw one at a pass end (or the end).
+    if (auto event = denoised_event(*job, *encodings, denoised_sent))
+      if (!write(id) || !write(*event)) return;
     seen = version;
     if (final_state) {
       write(sse("end", {{"state", status["state"]}}, version));

@@ -78,6 +78,7 @@ int http_status(JobErrorKind kind) {
     case JobErrorKind::no_storage: return 507;
     case JobErrorKind::scene_broken: return 422;
     case JobErrorKind::read_only: return 403;
+    case JobErrorKind::unsupported: return 422;
   }
   return 500;
 }

@@ -1,6 +1,7 @@
 // A job's render through the renderer's one render lifecycle (pt::run_render_job), for both
 // backends: the pass source's tiles, passes and checkpoints go to the job's sink, and what goes
 // wrong with a checkpoint goes to the log, naming the job.
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -42,7 +43,21 @@ RenderResult render_job(pt::PassSource& source, const Job& job, JobSink& sink, c
     source.film().read_tile_count(t, count);
     sink.tile(t, mean, count);
   };
-  events.pass = [&](const pt::PassReport& r) { sink.pass(report_of(source, estimate, r.error)); };
+  // Denoised pictures at pass ends (fast quality), while they cost at most a tenth of the render
+  // time so far; the first failure ends them (the job renders on, raw, saying why).
+  const bool denoising = job.spec.denoise != "off";
+  const int threads = std::max(1, job.spec.params.threads);
+  double denoise_spent = 0;
+  bool denoise_failed = false;
+  auto spp_of = [&] { return double(source.counts().samples) / double(std::max<size_t>(1, source.film().pixels())); };
+  events.pass = [&](const pt::PassReport& r) {
+    sink.pass(report_of(source, estimate, r.error));
+    if (!denoising || denoise_failed || !r.completed || source.finished() || denoise_spent > 0.1 * source.seconds()) return;
+    const pt::DenoisedFilm d = pt::denoise_film(source.film(), pt::DenoiseQuality::preview, threads, false);
+    denoise_spent += d.seconds;
+    denoise_failed = !d.ok;
+    sink.denoised(d, spp_of(), false);
+  };
   events.checkpointed = [&] { sink.checkpointed(source.counts().samples, source.seconds()); };
   // Another render's or a damaged checkpoint: render from the start, saying so.
   events.restore_failed = [&](const std::exception& e) {
@@ -55,6 +70,14 @@ RenderResult render_job(pt::PassSource& source, const Job& job, JobSink& sink, c
   RenderResult result;
   result.why = pt::run_render_job(source, limits, checkpoints.get(), &stop, events);
   result.image = source.film().image();
+  // The finished image (or what a user cancelled: it is stored too); not a pause or a shutdown.
+  const bool kept = result.why != pt::StopReason::cancelled || job.cancel;
+  if (denoising && kept && source.counts().samples > 0) {
+    const bool final = job.spec.denoise == "final";
+    result.denoised = pt::denoise_film(source.film(), final ? pt::DenoiseQuality::final : pt::DenoiseQuality::preview,
+                                       threads, final);
+    sink.denoised(result.denoised, spp_of(), true);
+  }
   result.report = report_of(source, estimate, source.error_estimate());
   result.seconds = source.seconds();
   return result;

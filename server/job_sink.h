@@ -101,6 +101,34 @@ class JobStateSink : public JobSink {
     j.changed.notify_all();
   }
 
+  void denoised(const pt::DenoisedFilm& d, double spp, bool final) override {
+    Job& j = m_job;
+    {
+      std::lock_guard<std::mutex> lock(j.mutex);
+      Job::Denoised& out = j.denoised;
+      if (!d.ok) {
+        out.warning = d.error + "; the picture is the raw render";
+      } else if (d.image.width == j.width && d.image.height == j.height) {
+        const size_t n = d.image.pixels.size();
+        out.linear.resize(n * 3);
+        out.display.resize(n * 3);
+        for (size_t i = 0; i < n; ++i)
+          for (int c = 0; c < 3; ++c) {
+            out.linear[i * 3 + c] = d.image.pixels[i][c];
+            out.display[i * 3 + c] = pt::tonemap_course(d.image.pixels[i][c]);
+          }
+        out.spp = spp;
+        out.seconds = d.seconds;
+        ++out.frames;
+        out.final = final;
+        out.noise = final && std::isfinite(d.noise) ? d.noise : -1;
+      }
+      out.spent_seconds += d.seconds + d.noise_seconds;
+      out.version = ++j.version;
+    }
+    j.changed.notify_all();
+  }
+
   void checkpointed(uint64_t samples, double seconds) override {
     std::lock_guard<std::mutex> lock(m_job.mutex);
     m_job.checkpoint_samples = samples;

@@ -177,6 +177,14 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
     const json* cam = r.get("camera");
     if (cam) p.camera = parse_camera(*cam);
   });
+  check([&] {
+    const json* d = r.get("denoise");
+    if (!d) return;
+    if (!d->is_string() || !valid_denoise_mode(d->get<std::string>()))
+      throw JobError(JobErrorKind::invalid, "'denoise' must be \"off\", \"preview\" or \"final\"", "denoise");
+    s.denoise = d->get<std::string>();
+    p.features = s.denoise != "off";
+  });
   pt::RunLimits run;
   for (const pt::RenderOption& o : pt::render_options()) {  // every field from the one table
     check([&] {
@@ -195,7 +203,7 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   s.target_error = run.target_error;
   for (auto it = body.begin(); it != body.end(); ++it)
     if (!r.seen.count(it.key())) {
-      std::vector<std::string> fields{"scene", "camera"};
+      std::vector<std::string> fields{"scene", "camera", "denoise"};
       for (const pt::RenderOption& o : pt::render_options()) fields.push_back(o.name);
       const std::string near = pt::nearest_name(it.key(), fields);
       errors.emplace_back(it.key(), "unknown field '" + it.key() + "'" + (near.empty() ? "" : " (did you mean '" + near + "'?)"));
@@ -236,8 +244,11 @@ json job_spec_to_json(const JobSpec& s) {
     }
   }
   j["camera"] = camera_pose_json(s.params.camera);
+  j["denoise"] = s.denoise;
   return j;
 }
+
+bool valid_denoise_mode(const std::string& mode) { return mode == "off" || mode == "preview" || mode == "final"; }
 
 json job_spec_defaults() {
   json j = job_spec_to_json(parse_job_spec(json{{"scene", "default"}}));

@@ -31,6 +31,7 @@ enum class JobErrorKind {
   no_storage,     // the data folder cannot store the job
   scene_broken,   // the job's scene no longer loads
   read_only,      // a bundled scene cannot be replaced or deleted
+  unsupported,    // a valid request this server cannot serve (denoising without the denoiser)
 };
 
 class JobError : public std::runtime_error {
@@ -56,7 +57,12 @@ struct JobSpec {
   pt::RenderParams params;    // threads is the server's, not the client's
   double time_limit = 0;      // seconds; 0 = none
   double target_error = 0;    // stop when the error estimate reaches this; 0 = none
+  // "off", "preview" (denoised frames at pass ends and a denoised image, fast quality) or "final"
+  // (the same, the finished image at high quality with its noise estimate). Not off: params.features.
+  std::string denoise = "off";
 };
+// The denoise field's values.
+bool valid_denoise_mode(const std::string& mode);
 
 // The job service's policy: narrower ranges than the render options' own (renderer/options.h) where a
 // job would cost the shared server too much, or its watchers too many tiles.

@@ -143,6 +143,7 @@ void JobManager::stop() {
 
 JobSpec JobManager::check(const json& body, uint64_t* scene_hash, std::vector<std::string>* warnings) {
   JobSpec spec = parse_job_spec(body, m_config.limits);
+  require_denoiser(spec);
   // A scene that does not load is refused here (422) rather than accepted as a job that fails.
   const uint64_t hash = m_scenes.check(spec.scene, warnings);
   if (scene_hash) *scene_hash = hash;
@@ -233,6 +234,7 @@ json JobManager::status_json(const Job& j, bool with_history) const {
          {"view", j.view},
          {"warnings", j.warnings},
          {"images", {{"png", "/api/jobs/" + j.id + "/image.png"}, {"exr", "/api/jobs/" + j.id + "/image.exr"}}},
+         {"denoise", denoise_json(j)},
          {"events", "/api/jobs/" + j.id + "/events"}};
   if (!j.message.empty()) s["message"] = j.message;
   if (!j.stopped.empty()) s["stopped"] = j.stopped;
@@ -340,6 +342,7 @@ void JobManager::load_persisted() {
         if (doc.contains("finished_at") && doc["finished_at"].is_number()) job->finished_at = doc["finished_at"];
         for (const json& p : doc.value("error_history", json::array()))
           job->history.push_back({p.value("seconds", 0.0), p.value("spp", 0.0), p.value("error", 0.0)});
+        load_denoise(*job, doc);
         for (const json& w : doc.value("warnings", json::array()))
           if (w.is_string()) job->warnings.push_back(to_valid_utf8(w.get<std::string>()));
         if (doc.contains("features"))
@@ -478,8 +481,7 @@ void JobManager::store_images(Job& job, const RenderResult& result) {
                     {"pathtracer:backend", m_backend->name()}};
   if (!job.view.is_null()) meta.push_back({"pathtracer:view", dump_json(job.view)});  // whatever framed it
   try {
-    retry_without_descriptors([&] { pt::write_image(img, job_dir(job.id) + "/image.exr", meta); });
-    retry_without_descriptors([&] { pt::write_image(img, job_dir(job.id) + "/image.png"); });
+    store_job_images(job_dir(job.id), result, meta);  // denoised (and raw), or raw
     std::string counts;
     {
       std::lock_guard<std::mutex> lock(job.mutex);

@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "image.h"
 #include "job_spec.h"
 #include "job_store.h"
 #include "scene_library.h"
@@ -74,6 +75,20 @@ struct Job {
   std::vector<uint64_t> region_version;  // the job version that last changed each region
   uint64_t passes = 0;                   // passes published so far (the whole-image PNG's cache key)
   bool has_image = false;
+
+  // Denoising (spec.denoise not "off"): the last denoised picture of the whole film, made at a pass
+  // end (the raw tiles go on arriving while a pass runs) or at the end.
+  struct Denoised {
+    std::vector<float> linear;     // empty: none yet
+    std::vector<uint8_t> display;
+    uint64_t version = 0;          // the job version it was published at
+    double spp = 0;                // the film's samples a pixel when it was made
+    double seconds = 0, spent_seconds = 0;  // the last one's time; all of them together
+    int frames = 0;
+    bool final = false;            // the finished image's
+    double noise = -1;             // its noise estimate (the denoised halves'); -1: none
+    std::string warning;           // why the picture is raw (the denoiser failed)
+  } denoised;
 };
 
 struct ManagerConfig {
@@ -98,6 +113,15 @@ struct JobPage {
   std::vector<std::shared_ptr<Job>> jobs;
   std::string next_cursor;  // "" on the last page
 };
+
+// A denoised job (job_denoise.cpp): its status part (null when not denoised), its persisted record,
+// and its image files (image.* denoised and image_raw.* raw, or image.* raw).
+json denoise_json(const Job& job);
+// Throws JobError(unsupported) naming the denoise field when the spec asks for a denoiser this
+// server lacks (a 422 that says how to install it).
+void require_denoiser(const JobSpec& spec);
+void load_denoise(Job& job, const json& doc);
+void store_job_images(const std::string& dir, const RenderResult& result, pt::Metadata meta);
 
 class JobManager {
  public:

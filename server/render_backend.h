@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "film_denoise.h"
 #include "session.h"
 
 namespace srv {
@@ -37,6 +38,9 @@ class JobSink {
   virtual void pass(const RenderReport& r) = 0;
   // A checkpoint now holds `samples` taken in `seconds` of rendering: what a restart resumes from.
   virtual void checkpointed(uint64_t samples, double seconds) = 0;
+  // A denoised picture of the film at `spp` samples a pixel (at a pass end, or `final`), or why
+  // there is none (d.ok false: the picture stays raw).
+  virtual void denoised(const pt::DenoisedFilm& d, double spp, bool final) = 0;
 };
 
 struct RenderResult {
@@ -44,6 +48,7 @@ struct RenderResult {
   pt::ImageRGB image;
   RenderReport report;
   double seconds = 0;  // rendering time
+  pt::DenoisedFilm denoised;  // the finished image denoised (a job that asks for it; ok when it worked)
 };
 
 // Where a job's render keeps its checkpoints (renderer/checkpoint.h): a render starts from the file

@@ -9,6 +9,7 @@
 #include <functional>
 #include <regex>
 
+#include "denoiser.h"
 #include "event_stream.h"
 #include "image.h"
 #include "job_store.h"
@@ -47,6 +48,8 @@ void get_health(JobManager& jobs, const ApiOptions&, const Request&, Response& r
   health["stream"] = {{"watchers", st.watchers}, {"png_encodes", st.png_encodes}, {"tile_events", st.tile_events}};
   int workers = jobs.live_workers();
   if (workers >= 0) health["workers"] = workers;
+  const pt::Denoiser& denoiser = pt::Denoiser::shared();  // a job's denoise field needs it
+  health["denoiser"] = {{"available", denoiser.available()}, {"description", denoiser.summary()}};
   send_json(res, 200, health);
 }
 
@@ -172,30 +175,44 @@ void get_image(JobManager& jobs, const ApiOptions&, const Request& req, Response
   auto job = job_or_404(jobs, req);
   std::string ext = req.matches[2];
   const char* type = ext == "png" ? "image/png" : "image/x-exr";
-  bool done, has_image;
+  // ?raw=1: a denoised job's raw render (any other job's image is raw already).
+  const std::string raw_param = req.has_param("raw") ? req.get_param_value("raw") : "0";
+  if (raw_param != "0" && raw_param != "1") throw HttpError(400, "raw must be 0 or 1", "raw");
+  const bool raw = raw_param == "1";
+  bool done, has_image, denoised;
   std::string state;
   {
     std::lock_guard<std::mutex> lock(job->mutex);
     done = job->state == JobState::done;
     has_image = job->has_image;
+    denoised = !raw && !job->denoised.linear.empty();
     state = job_state_name(job->state);
   }
   if (!done && !has_image) throw HttpError(404, "job has no image yet (state " + state + ")");
   res.set_header("Cache-Control", "no-store");
   std::string data;
-  // A done job's files (a regular file only: never a link or a FIFO someone put there).
-  if (done && read_file(jobs.job_dir(job->id) + "/image." + ext, data)) return res.set_content(data, type);
+  // A done job's files (a regular file only: never a link or a FIFO someone put there); a denoised
+  // job keeps its raw render beside them.
+  const std::string dir = jobs.job_dir(job->id) + "/";
+  if (done && raw && read_file(dir + "image_raw." + ext, data)) return res.set_content(data, type);
+  if (done && read_file(dir + "image." + ext, data)) return res.set_content(data, type);
   if (!has_image) throw HttpError(404, "the job's image is missing");
-  if (ext == "png") return res.set_content(current_png(*job), type);  // encoded once a pass for all
+  if (ext == "png" && !denoised) return res.set_content(current_png(*job), type);  // encoded once a pass for all
   pt::ImageRGB img;
+  std::vector<uint8_t> display;
   {
     std::lock_guard<std::mutex> lock(job->mutex);
     img.width = job->width;
     img.height = job->height;
     img.pixels.resize(size_t(img.width) * img.height);
-    std::memcpy(static_cast<void*>(img.pixels.data()), job->linear.data(), img.pixels.size() * sizeof(pt::Vec3));
+    const std::vector<float>& linear = denoised ? job->denoised.linear : job->linear;
+    if (linear.size() != img.pixels.size() * 3) throw HttpError(404, "the job's image is missing");
+    if (ext == "png") display = job->denoised.display;
+    else std::memcpy(static_cast<void*>(img.pixels.data()), linear.data(), img.pixels.size() * sizeof(pt::Vec3));
   }
-  res.set_content(pt::encode_exr(img), type);  // outside the mutex the render threads take
+  // Outside the mutex the render threads take.
+  if (ext == "png") return res.set_content(pt::encode_png8(display, img.width, img.height), type);
+  res.set_content(pt::encode_exr(img), type);
 }
 
 // GET /api/jobs/{id}/pixels: the linear image as little-endian float32, (R, G, B, samples taken) a

@@ -95,8 +95,10 @@ TEST(Options, JobFieldsAreTheTableNarrowedByTheServersPolicy) {
   srv::SpecLimits lim;
   srv::json defaults = srv::job_spec_defaults();
   std::set<std::string> fields;
-  for (auto it = defaults.begin(); it != defaults.end(); ++it) fields.insert(it.key());
+  for (auto it = defaults.begin(); it != defaults.end(); ++it)
+    if (it.key() != "denoise") fields.insert(it.key());  // a choice of the service's, not a render option
   EXPECT_EQ(fields.size(), pt::render_options().size());
+  EXPECT_EQ(defaults["denoise"], "off");
   for (const RenderOption& o : pt::render_options()) {
     ASSERT_TRUE(defaults.contains(o.name)) << o.name;
     if (o.type == OptionType::boolean) EXPECT_EQ(defaults[o.name].get<bool>(), o.service != 0) << o.name;
@@ -132,8 +134,8 @@ TEST(Options, TheOpenApiJobFieldsMatchTheTable) {
     const srv::json& props = doc["components"]["schemas"][schema]["properties"];
     std::set<std::string> documented;
     for (auto it = props.begin(); it != props.end(); ++it)
-      // The camera is a pose, not an option of the table (camera.h).
-      if (it.key() != "scene" && it.key() != "camera") documented.insert(it.key());
+      // The camera is a pose, not an option of the table (camera.h); denoise is the service's choice.
+      if (it.key() != "scene" && it.key() != "camera" && it.key() != "denoise") documented.insert(it.key());
     EXPECT_EQ(documented.size(), pt::render_options().size()) << schema;
     for (const RenderOption& o : pt::render_options()) {
       SCOPED_TRACE(std::string(schema) + "." + o.name);

@@ -9,6 +9,7 @@
 
 #include "cli.h"
 #include "collada.h"
+#include "denoiser.h"
 #include "session.h"
 #include "viewer_harness.h"
 
@@ -267,4 +268,32 @@ TEST_F(Viewer, ADepthThatBlacksOutMirrorsSaysWhyOnce) {
   };
   EXPECT_EQ(count("hint: -m 2 leaves mirror and glass dark"), 1u) << r.output;
   EXPECT_EQ(count("hint: -m 1 leaves mirror and glass black"), 1u) << r.output;
+}
+
+// N shows the film denoised at pass ends (restarting once to gather the denoiser's features), and
+// the denoised picture is smoother than the raw one the same render shows after N again.
+TEST_F(Viewer, NShowsTheDenoisedFilm) {
+  if (!Denoiser::shared().available()) {
+    if (test::under_ci()) FAIL() << "under CI=true the denoiser must be installed: " << Denoiser::shared().description();
+    GTEST_SKIP() << Denoiser::shared().description();
+  }
+  RunResult r = run_window("-t 2 -s 16 -m 3 -r 120 90 --seed 3 --no-adaptive",
+                           "key `\nkey N\nwait_spp 16\nsync\nscreenshot " + m_dir + "/denoised.png\nkey N\nsync\nscreenshot " +
+                               m_dir + "/raw.png\nquit\n");
+  const std::string& o = r.output;
+  EXPECT_NE(o.find("view: denoised (the render restarts"), std::string::npos) << o;
+  EXPECT_NE(o.find("denoised: 16 spp in"), std::string::npos) << o;
+  EXPECT_NE(o.find("view: radiance"), std::string::npos) << o;
+  auto roughness = [](const std::string& path) {  // squared differences of horizontal neighbours
+    const ImageRGB img = read_image(path);
+    double sum = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x + 1 < img.width; ++x) {
+        const float d = luminance(img.at(x + 1, y)) - luminance(img.at(x, y));
+        sum += double(d) * d;
+      }
+    return sum;
+  };
+  const double denoised = roughness(m_dir + "/denoised.png"), raw = roughness(m_dir + "/raw.png");
+  EXPECT_LT(denoised, 0.7 * raw) << "denoised " << denoised << ", raw " << raw;
 }

@@ -273,7 +273,10 @@ const std::vector<WindowKey>& window_keys() {
       {"' / ;", "focus +/- 0.1", "focal distance +0.1 / -0.1 (min 0): focal plane farther / nearer"},
       {"] / [", "spp x2 / /2", "samples per pixel x2 / /2"},
       {"= / -", "light samples x2 / /2", "light samples x2 / /2"},
-      {"T", "sample-rate view", "toggle the sample-rate view (with its colour legend)"},
+      {"T / N", "rate / denoised view", "toggle the sample-rate view (with its colour legend) / the denoised view:\n"
+                                        "the film denoised (Intel Open Image Denoise) after passes long enough for\n"
+                                        "it to pay (a tenth of the render time at most) and at the end; the render\n"
+                                        "restarts once to gather the denoiser's albedo and normal"},
       {"S", "save the image", "save <scene>_screenshot_<M>-<D>_<h>-<m>-<s>.png, .exr and _rate.png\n"
                               "in the current directory (or --output-dir)"},
       {"D", "write the camera", "write the camera settings to <scene>_cam_settings.txt (there too)"},

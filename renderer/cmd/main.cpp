@@ -87,13 +87,13 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
     std::printf("%s\n", version_text("pathtracer").c_str());
     return 0;
   }
+  if (o.denoise && !o.describe && !Denoiser::shared().available()) {  // before the render, not after it
+    std::fprintf(stderr, "pathtracer: --denoise: %s\n", Denoiser::shared().description().c_str());
+    return 1;
+  }
   if (o.output.empty() && !o.describe) return run_viewer(o, script);
   if (script) {
     std::fprintf(stderr, "pathtracer: --script drives the window; it cannot be used with -f\n");
-    return 1;
-  }
-  if (o.denoise && !o.describe && !Denoiser::shared().available()) {  // before the render, not after it
-    std::fprintf(stderr, "pathtracer: --denoise: %s\n", Denoiser::shared().description().c_str());
     return 1;
   }
   std::string doing = "loading " + o.scene_path;  // what an out-of-memory message names

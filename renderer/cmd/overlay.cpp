@@ -112,7 +112,7 @@ std::string progress_text(const Status& st, bool current) {
   return spp_text(st, current) + (eta.empty() ? "" : " | " + eta);
 }
 
-std::vector<std::string> status_lines(const Status& st, const RenderParams& p, bool current, bool rate_view) {
+std::vector<std::string> status_lines(const Status& st, const RenderParams& p, bool current, const std::string& view) {
   std::vector<std::string> l;
   l.push_back(spp_text(st, current));
   l.push_back("error " + format_error_estimate(current ? st.error : INFINITY));
@@ -122,7 +122,7 @@ std::vector<std::string> status_lines(const Status& st, const RenderParams& p, b
   l.push_back("lens radius " + fmt_g(p.lens_radius));
   l.push_back("focal dist " + fmt_g(p.focal_distance));
   l.push_back("light samples " + std::to_string(p.light_samples));
-  l.push_back(rate_view ? "view sample rate" : "view radiance");
+  l.push_back("view " + view);
   l.push_back("H hide, ? keys");
   return l;
 }
@@ -194,7 +194,10 @@ Overlay layout_overlay(const OverlayInputs& in, int fw, int fh) {
   }
   o.panel = in.show_panel || in.show_keys;
   if (o.panel)
-    o.panel_layout = layout_panel(in.show_keys ? key_lines() : status_lines(in.status, in.params, in.current, in.show_rate),
+    o.panel_layout = layout_panel(in.show_keys ? key_lines() : status_lines(in.status, in.params, in.current,
+                                                                          in.show_rate       ? "sample rate"
+                                                                          : in.show_denoised ? "denoised"
+                                                                                             : "radiance"),
                                   fw, fh, bottom);
   return o;
 }

@@ -18,7 +18,8 @@ struct Rect {
 };
 
 // The status panel's lines, most important first: a window too small for all shows the first.
-std::vector<std::string> status_lines(const Status& st, const RenderParams& p, bool current, bool rate_view);
+// `view`: what the image shows ("radiance", "sample rate", "denoised").
+std::vector<std::string> status_lines(const Status& st, const RenderParams& p, bool current, const std::string& view);
 // The key list in the panel's brief form (window_keys), for the ? key.
 std::vector<std::string> key_lines();
 // Samples, progress and ETA in a few words ("spp 8/64 | ETA 3s, 12%"): the window title's status.
@@ -46,6 +47,7 @@ struct OverlayInputs {
   RenderParams params;
   bool current = false;  // the status is the session of `params`
   bool show_panel = true, show_keys = false, show_rate = false, have_image = false;
+  bool show_denoised = false;  // the denoised picture is shown (N)
   uint32_t min_count = 0, max_count = 0;  // the image's fewest and most samples in a pixel
 };
 

@@ -19,6 +19,7 @@
 #include <mutex>
 #include <thread>
 
+#include "denoiser.h"
 #include "hints.h"
 #include "overlay.h"
 #include "scene_file.h"
@@ -187,8 +188,9 @@ class Viewer : public ScriptHost {
       case GLFW_KEY_T:
         m_show_rate = !m_show_rate;
         upload_all();
-        say("view: %s", m_show_rate ? "sample rate" : "radiance");
+        say("view: %s", m_show_rate ? "sample rate" : m_show_denoised ? "denoised" : "radiance");
         break;
+      case GLFW_KEY_N: toggle_denoised(); break;
       case GLFW_KEY_SLASH:  // '?' on most layouts
         set_show_keys(!m_show_keys);
         if (m_show_keys) {
@@ -204,6 +206,30 @@ class Viewer : public ScriptHost {
         break;
       default: break;
     }
+  }
+
+  // The denoised view: the film denoised at pass ends (viewer_loop.h). A render without the
+  // denoiser's features restarts with them.
+  void toggle_denoised() {
+    if (!Denoiser::shared().available()) {
+      say("denoiser: %s", Denoiser::shared().description().c_str());
+      return;
+    }
+    m_show_denoised = !m_show_denoised;
+    bool restart = false;
+    {
+      std::lock_guard<std::mutex> lk(m_sh.mutex);
+      if (m_show_denoised && !m_sh.want.features) {
+        m_sh.want.features = true;
+        ++m_sh.want_gen;
+        restart = true;
+      }
+    }
+    m_sh.wake.notify_all();
+    if (restart) m_sh.cancel = true;
+    upload_all();
+    say("view: %s%s", m_show_denoised ? "denoised" : "radiance",
+        restart ? " (the render restarts with the denoiser's albedo and normal features)" : "");
   }
 
   void set_show_keys(bool on) {
@@ -228,10 +254,23 @@ class Viewer : public ScriptHost {
       }
     }
     std::vector<TileUpdate> tiles;
+    bool new_denoised = false;
     {
       std::lock_guard<std::mutex> lk(m_sh.tile_mutex);
       tiles.swap(m_sh.tiles);
+      const Shared::Denoised& d = m_sh.denoised;
+      if (d.gen == m_tex_gen && d.number != m_denoised_number && !m_rgb.empty()) {
+        // Over the raw picture at the session's cell offset, as its tiles are.
+        m_denoised_number = d.number;
+        m_denoised_gen = d.gen;
+        m_denoised = m_rgb;
+        for (int y = 0; y < d.height && y + m_cell_y0 < m_tex_h; ++y)
+          std::copy(d.rgb.begin() + size_t(y) * d.width * 3, d.rgb.begin() + size_t(y + 1) * d.width * 3,
+                    m_denoised.begin() + (size_t(y + m_cell_y0) * m_tex_w + m_cell_x0) * 3);
+        new_denoised = true;
+      }
     }
+    if (new_denoised && m_show_denoised && !m_show_rate) upload_all();
     for (const TileUpdate& u : tiles) {
       if (u.gen != m_tex_gen) continue;  // from a session that was replaced
       const Tile& t = u.tile;
@@ -248,7 +287,8 @@ class Viewer : public ScriptHost {
   }
 
   void upload_rect(int x, int y, int w, int h) {
-    const std::vector<uint8_t>& src = m_show_rate ? m_rate : m_rgb;
+    const bool denoised = m_show_denoised && m_denoised.size() == m_rgb.size() && m_denoised_gen_ok();
+    const std::vector<uint8_t>& src = m_show_rate ? m_rate : denoised ? m_denoised : m_rgb;
     if (src.empty()) return;
     gl_texture_update(m_tex, src.data(), m_tex_w, x, y, w, h);
     m_dirty = true;
@@ -282,6 +322,7 @@ class Viewer : public ScriptHost {
       in.current = in.status.gen == m_sh.want_gen;
     }
     in.show_panel = m_show_panel, in.show_keys = m_show_keys, in.show_rate = m_show_rate;
+    in.show_denoised = m_show_denoised;
     in.have_image = m_tex_w > 0;
     if (m_show_rate && !m_count.empty()) {
       auto [lo, hi] = std::minmax_element(m_count.begin(), m_count.end());
@@ -326,6 +367,10 @@ class Viewer : public ScriptHost {
   std::vector<uint8_t> m_rgb, m_rate;  // what the texture holds, for each view
   std::vector<uint32_t> m_count;       // samples in each pixel, for the rate legend
   bool m_show_rate = false, m_show_keys = false, m_show_panel = true, m_dirty = true;
+  bool m_show_denoised = m_options.denoise;  // N; --denoise starts with it
+  std::vector<uint8_t> m_denoised;  // the last denoised picture of the texture's session, texture-sized
+  uint64_t m_denoised_number = 0, m_denoised_gen = 0;
+  bool m_denoised_gen_ok() const { return m_denoised_gen == m_tex_gen; }
   std::vector<std::string> m_panel_lines;  // as last drawn: the ETA counts down between passes
   std::string m_title;
   int m_exit = 0;

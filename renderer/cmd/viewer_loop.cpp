@@ -7,6 +7,7 @@
 #include <ctime>
 #include <sstream>
 
+#include "film_denoise.h"
 #include "scene_file.h"
 
 namespace pt {
@@ -111,6 +112,7 @@ void RenderLoop::loop() {
         say("pass: %d/%d spp, error estimate %s, %.2f s%s", st.reached_spp, st.spp,
             format_error_estimate(st.error).c_str(), st.seconds,
             m_done && why != StopReason::finished ? (std::string(", ") + stop_reason_name(why)).c_str() : "");
+      if (r.completed || m_done) denoise_after_pass(r, m_done);
     }
     lk.lock();
     if (reported) m_sh.status = m_status;
@@ -140,6 +142,8 @@ void RenderLoop::start_session(const RenderParams& p, const ViewPose& view, uint
   m_params = p;
   m_gen = gen;
   m_done = false;
+  m_denoise_spent = 0;
+  m_denoise_failed = false;
   m_status = Status{};
   m_status.gen = gen;
   m_status.width = m_session->width();
@@ -151,6 +155,29 @@ void RenderLoop::start_session(const RenderParams& p, const ViewPose& view, uint
   m_status.spp = p.spp;
   std::lock_guard<std::mutex> lk(m_sh.mutex);
   m_sh.status = m_status;
+}
+
+void RenderLoop::denoise_after_pass(const PassReport& r, bool finished) {
+  if (!m_session->film().has_features() || m_denoise_failed) return;
+  if (!finished && m_denoise_spent > 0.1 * r.seconds) return;  // it would cost more than it shows
+  const DenoisedFilm d = denoise_film(m_session->film(), finished ? DenoiseQuality::final : DenoiseQuality::preview,
+                                      m_params.threads, false);
+  m_denoise_spent += d.seconds;
+  if (!d.ok) {
+    m_denoise_failed = true;
+    say("denoiser: %s; the view stays raw", d.error.c_str());
+    return;
+  }
+  if (!m_options.quiet)
+    say("denoised: %d spp in %.3f s (%s)", r.target_spp, d.seconds, finished ? "final" : "preview");
+  std::vector<uint8_t> rgb(d.image.pixels.size() * 3);
+  for (size_t i = 0; i < d.image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = tonemap_course(d.image.pixels[i][c]);
+  std::lock_guard<std::mutex> lk(m_sh.tile_mutex);
+  m_sh.denoised.gen = m_gen;
+  ++m_sh.denoised.number;
+  m_sh.denoised.width = d.image.width, m_sh.denoised.height = d.image.height;
+  m_sh.denoised.rgb = std::move(rgb);
 }
 
 void RenderLoop::send_tile(uint64_t gen, const RenderSession& s, const Tile& t) {

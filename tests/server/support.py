@@ -299,7 +299,8 @@ class Event:
         return f"Event({self.kind}, id={self.id})"
 
 
-EVENT_SCHEMAS = {"image": "ImageEvent", "status": "StatusEvent", "tile": "TileEvent", "end": "EndEvent"}
+EVENT_SCHEMAS = {"image": "ImageEvent", "status": "StatusEvent", "tile": "TileEvent", "denoised": "DenoisedEvent",
+                 "end": "EndEvent"}
 
 
 class EventStream:
@@ -371,7 +372,8 @@ def health_counts(health):
     assert set(health["stream"]) == {"watchers", "png_encodes", "tile_events"}, health
     assert isinstance(health["data_bytes"], int) and health["data_bytes"] >= 0, health
     assert set(health["version"]) == {"version", "commit", "embree", "openimageio"}, health
-    return {k: v for k, v in health.items() if k not in ("stream", "data_bytes", "version")}
+    assert set(health["denoiser"]) == {"available", "description"}, health
+    return {k: v for k, v in health.items() if k not in ("stream", "data_bytes", "version", "denoiser")}
 
 
 # ---- raw HTTP, for requests no client library would send ----
