@@ -1,7 +1,8 @@
-"""Cycles renders of a glTF file for bench/vs_cycles.py, through Blender as a Python module (bpy, in
-build/cycles-venv): the file is read by Blender's own glTF importer, as a user's would be, and
-rendered with the settings of issue #52 (configure). Also reads EXRs with the OpenImageIO module
-that the bpy wheel bundles, and offers scene variants that test one convention at a time (VARIANTS).
+"""Cycles renders of a glTF file for bench/vs_cycles.py and bench/denoise_bench.py, through Blender
+as a Python module (bpy, in build/cycles-venv): the file is read by Blender's own glTF importer, as a
+user's would be, and rendered with the settings of issue #52 (configure), with or without Cycles'
+denoiser (set_denoising). Also reads EXRs with the OpenImageIO module that the bpy wheel bundles,
+and offers scene variants that test one convention at a time (VARIANTS).
 """
 import contextlib
 import os
@@ -220,11 +221,30 @@ def configure(width, height, bounces, threads):
     settings.exr_codec = "ZIP"
 
 
+def set_denoising(on):
+    """Cycles' denoiser on or off (configure leaves it off). On: Blender's defaults for a final
+    render, Open Image Denoise on the CPU with albedo and normal passes, prefilter ACCURATE (the
+    passes denoised first) and quality HIGH; the EXR's combined pass is then the denoised image."""
+    scene = bpy.context.scene
+    c = scene.cycles
+    c.use_denoising = on
+    bpy.context.view_layer.cycles.use_denoising = True
+    if on:
+        c.denoiser = "OPENIMAGEDENOISE"
+        c.denoising_input_passes = "RGB_ALBEDO_NORMAL"
+        c.denoising_prefilter = "ACCURATE"
+        c.denoising_quality = "HIGH"
+        c.denoising_use_gpu = False
+
+
 def render(out, spp, seed, on_progress=None):
     """Renders to the EXR `out`; returns the path-tracing seconds (from the first sample to the
     last, as Cycles' progress reports them: without the scene's sync, BVH build and saving).
+    With denoising on, to Cycles' "Finished" instead, so that the denoising after the last sample
+    is counted (the denoiser's kernels load before the first sample, as the render's do).
     on_progress(fraction) follows Cycles' sample count."""
     scene = bpy.context.scene
+    denoising = scene.cycles.use_denoising
     scene.cycles.samples = spp
     scene.cycles.seed = seed
     scene.render.filepath = str(out)
@@ -237,7 +257,7 @@ def render(out, spp, seed, on_progress=None):
             marks.setdefault("start", now)
             if on_progress:
                 on_progress(int(m.group(1)) / int(m.group(2)))
-        if "Finished" in text or f"Sample {spp}/{spp}" in text:
+        if "Finished" in text or (not denoising and f"Sample {spp}/{spp}" in text):
             marks.setdefault("end", now)
 
     bpy.app.handlers.render_stats.append(on_stats)
