@@ -11,7 +11,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <tuple>
+#include <type_traits>
 #include <vector>
 
 namespace pt {

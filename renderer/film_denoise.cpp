@@ -49,6 +49,8 @@ DenoisedFilm denoise_film(const Film& film, DenoiseQuality quality, int threads,
     FilmFeatures f = film.features();
     clamp_inputs(color, f);
     if (!d.denoise(color, f.albedo, f.normal, quality, threads, out.image, out.error)) return out;
+    for (size_t i = 0; i < out.image.pixels.size(); ++i)  // never a NaN out, whatever the library does
+      if (!is_finite(out.image.pixels[i])) out.image.pixels[i] = color.pixels[i];
     out.seconds = seconds_since(t0);
     out.ok = true;
     if (!estimate) return out;

@@ -1,7 +1,9 @@
 // A stand-in for Intel Open Image Denoise's C API (the part renderer/denoiser.cpp calls), for the
 // tests of what a broken or foreign library does: PT_OIDN_LIB points at it. Its "version" is
 // $FAKE_OIDN_VERSION (default 20501); with $FAKE_OIDN_FAIL set, executing a filter fails as out
-// of memory; otherwise a filter copies its colour to its output (a denoiser that does nothing).
+// of memory; otherwise a filter copies its colour to its output (a denoiser that does nothing),
+// with $FAKE_OIDN_NAN set putting NaNs in it.
+#include <cmath>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
@@ -49,6 +51,8 @@ void oidnExecuteFilter(Filter* f) {
     return;
   }
   if (f->color && f->output && f->color != f->output) std::memcpy(f->output, f->color, f->bytes);
+  if (f->output && std::getenv("FAKE_OIDN_NAN"))  // a library that writes garbage
+    for (size_t i = 0; i < f->bytes / sizeof(float); i += 7) f->output[i] = std::nanf("");
 }
 void oidnReleaseFilter(Filter* f) { delete f; }
 }

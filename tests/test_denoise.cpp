@@ -251,3 +251,14 @@ TEST(DenoiseCli, AFailingDenoiserLeavesTheRawImageWithAWarning) {
   EXPECT_NE(r.output.find("writing the raw image"), std::string::npos) << r.output;
   EXPECT_TRUE(test::file_exists(out));
 }
+
+// Whatever the library writes, no NaN reaches the image: its pixel keeps the raw colour.
+TEST(DenoiseCli, ANonFiniteDenoiserOutputNeverReachesTheImage) {
+  const std::string out = test::temp_dir() + "/nan.exr";
+  const test::RunResult r = test::run_command(std::string("FAKE_OIDN_NAN=1 PT_OIDN_LIB=") + PT_FAKE_OIDN + " " +
+                                              PT_PATHTRACER + " -s 2 -r 16 12 --quiet --denoise -f " + out + " " +
+                                              test::own_scene("cornell.dae"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const ImageRGB img = read_image(out);
+  for (const Vec3& v : img.pixels) ASSERT_TRUE(is_finite(v));
+}
