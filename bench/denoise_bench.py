@@ -92,7 +92,7 @@ def parse_error_log(text):
         except (TypeError, ValueError):
             return math.nan
 
-    return [{c: number(row.get(c)) for c in LOG_COLUMNS} for row in reader]
+    return [{c: number(row.get(c)) for c in LOG_COLUMNS + ("preview_denoise_seconds",)} for row in reader]
 
 
 def reference_noise(raw_err, spp, ref_spp):
@@ -184,6 +184,22 @@ def denoise_cost(rows):
     d, p = statistics.median(den), statistics.median(passes)
     rate = rows[-1]["spp"] / rows[-1]["seconds"]
     return dict(median=d, first=den[0], pass_median=p, ratio=d / p if p > 0 else math.inf, spp=d * rate)
+
+
+def preview_cost(rows):
+    """The fast-quality denoise of a pass end (the window's and the page's pictures) against that
+    pass's rendering: (spp, pass seconds, preview seconds) per pass with the log's
+    preview_denoise_seconds, and the first spp from which the preview costs under a tenth of its pass
+    (None: never)."""
+    out, first = [], None
+    for a, b in zip([{"seconds": 0.0}] + rows, rows):
+        p, d = b["seconds"] - a["seconds"], b.get("preview_denoise_seconds", math.nan)
+        if math.isnan(d):
+            continue
+        out.append((b["spp"], p, d))
+        if first is None and d < 0.1 * p:
+            first = b["spp"]
+    return out, first
 
 
 def curve_lines(label, points):
@@ -402,6 +418,11 @@ def main():
         notes.append(f"{name} (-m {depth}): our denoise {cost['median']:.3g} s a pass (median of {len(log_rows)}; the "
                      f"first {cost['first']:.3g} s, device set-up included) = {cost['ratio']:.2f} x the median pass's "
                      f"rendering ({cost['pass_median']:.3g} s), or {cost['spp']:.3g} spp at the run's rate")
+        passes, first = preview_cost(log_rows)
+        if passes:
+            notes.append(f"{name}: a preview (fast) denoise costs " + ", ".join(
+                f"{d / p:.0%} of the {n:g}-spp pass" for n, p, d in passes[-4:]) +
+                (f"; under 10% of its pass from {first:g} spp" if first else "; never under 10% of its pass"))
         cycles = None
         if kind == "glb":
             cycles, extra = run_cycles(args, cr, np, name, path, depth, work)

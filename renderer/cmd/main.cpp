@@ -131,7 +131,9 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
       log = std::fopen(o.error_log.c_str(), "w");
       if (!log) throw std::runtime_error(o.error_log + ": cannot write the error log");
       std::fprintf(log, "seconds,spp,error_estimate%s%s\n", reference.pixels.empty() ? "" : ",rmse,rel_mse",
-                   !o.denoise ? "" : reference.pixels.empty() ? ",denoise_seconds" : ",denoise_seconds,denoised_rel_mse");
+                   !o.denoise                 ? ""
+                   : reference.pixels.empty() ? ",denoise_seconds,preview_denoise_seconds"
+                                              : ",denoise_seconds,denoised_rel_mse,preview_denoise_seconds");
     }
     ProgressBar bar("Rendering", !o.quiet);
     double pixels = double(session.width()) * session.height();
@@ -197,6 +199,8 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
         const DenoisedFilm d = denoise_film(session.film(), DenoiseQuality::final, o.params.threads, false);
         std::fprintf(log, ",%.6g", d.seconds);
         if (!reference.pixels.empty()) std::fprintf(log, ",%.6g", d.ok ? relative_mse(d.image, reference) : NAN);
+        // And what the window's and the page's pictures at pass ends cost (fast quality).
+        std::fprintf(log, ",%.6g", denoise_film(session.film(), DenoiseQuality::preview, o.params.threads, false).seconds);
       }
       std::fprintf(log, "\n");
       std::fflush(log);

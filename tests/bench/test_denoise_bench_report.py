@@ -19,6 +19,8 @@ class Report(unittest.TestCase):
     def test_the_error_log_reads_as_numbers(self):
         rows = db.parse_error_log(LOG)
         self.assertEqual(len(rows), 3)
+        preview = rows[1].pop("preview_denoise_seconds")  # an older log has no such column: NaN
+        self.assertTrue(math.isnan(preview))
         self.assertEqual(rows[1], dict(seconds=0.004782, spp=2.0, rel_mse=0.159724, denoise_seconds=0.0260627,
                                        denoised_rel_mse=0.040207))
         self.assertTrue(math.isnan(rows[2]["denoised_rel_mse"]))
@@ -96,6 +98,14 @@ class Report(unittest.TestCase):
         self.assertAlmostEqual(cost["pass_median"], 1.5)  # passes of 1, 1, 2 and 4 s
         self.assertAlmostEqual(cost["ratio"], 0.1)
         self.assertAlmostEqual(cost["spp"], 0.15)  # 1 spp a second
+
+    def test_the_preview_cost_per_pass(self):
+        rows = [dict(seconds=s, spp=n, preview_denoise_seconds=d) for s, n, d in
+                [(1.0, 1, 0.5), (2.0, 2, 0.2), (4.0, 4, 0.15), (8.0, 8, math.nan)]]
+        passes, first = db.preview_cost(rows)
+        self.assertEqual(passes, [(1, 1.0, 0.5), (2, 1.0, 0.2), (4, 2.0, 0.15)])
+        self.assertEqual(first, 4)  # 0.15 s against a 2 s pass
+        self.assertEqual(db.preview_cost(rows[:2])[1], None)
 
     def test_the_spp_ladder(self):
         self.assertEqual(db.spp_ladder(1), [1])
