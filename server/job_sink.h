@@ -41,6 +41,9 @@ class JobStateSink : public JobSink {
       while (!j.history.empty() && !(j.history.back().seconds <= resumed_seconds)) j.history.pop_back();
       j.has_image = false;
       j.features = features;
+      j.denoised.final = false;  // a continued job renders on: its last picture is no longer the finished one
+      j.denoised.noise = -1;
+      j.denoised.warning.clear();
       ++j.version;
       m_persist(j);
     }

@@ -237,12 +237,14 @@ void get_pixels(JobManager& jobs, const ApiOptions&, const Request& req, Respons
   }
   if (w == 0) {
     if (!done) throw HttpError(404, "job has no image yet (state " + state + ")");
-    // Finished before a restart: its files hold what the memory held.
+    // Finished before a restart: its files hold what the memory held (a denoised job's raw render
+    // is image_raw.exr: these are the samples' values).
     const std::string dir = jobs.job_dir(job->id);
+    const std::string file = dir + (is_regular_file(dir + "/image_raw.exr") ? "/image_raw.exr" : "/image.exr");
     std::string bytes;
-    if (!is_regular_file(dir + "/image.exr")) throw HttpError(404, "the job's image is missing");
+    if (!is_regular_file(file)) throw HttpError(404, "the job's image is missing");
     if (!read_file(dir + "/samples.bin", bytes)) throw HttpError(404, "the job's sample counts are missing");
-    const pt::ImageRGB img = pt::read_image(dir + "/image.exr");
+    const pt::ImageRGB img = pt::read_image(file);
     if (!decode_sample_counts(bytes, img.pixels.size(), counts))
       throw HttpError(404, "the job's sample counts do not fit its image");
     w = img.width, h = img.height;

@@ -1,8 +1,9 @@
 // The render-job page: the viewer fed by the job's event stream (tiles paint as they arrive),
 // click-to-focus, and the wiring. No framework, no build step: common.js (state, API), feed.js (a
 // job's event stream), chart.js, sweep.js, jobs.js (the job list), viewer_tools.js (exposure,
-// mappings, zoom, readout), compare.js, upload.js, form.js (the form) and camera.js (moving the
-// camera on the image) load before this file (index.html), as plain scripts sharing their names.
+// mappings, zoom, readout), compare.js, denoise.js (the denoise control and the raw / denoised
+// switch), upload.js, form.js (the form) and camera.js (moving the camera on the image) load
+// before this file (index.html), as plain scripts sharing their names.
 'use strict';
 
 // ---------- the main viewer ----------
@@ -44,6 +45,7 @@ const viewer = {
     $('#v-more-form').hidden = true;
     setLink($('#v-png'), null);
     setLink($('#v-exr'), null);
+    resetDenoise();
     drawChart($('#v-chart'), []);
     const c = $('#v-canvas');
     if (!this.keepPicture) clearCanvas(c, c.width, c.height);
@@ -70,8 +72,10 @@ const viewer = {
       tools.onResize(oldWidth, canvas.width);
       fitStage();
     } else if (type === 'pixels') {
-      if (!tools.active()) syncCanvas(canvas, feed, rect);  // else the tools paint from the float pixels
-      tools.onPixels(feed.ended);
+      // The tools paint from the float pixels; else the picture picked (raw or denoised).
+      if (!tools.active()) syncCanvas(canvas, feed, rect, denoiseView.choice);
+      if (rect && rect.denoised) showPicture();  // a denoised picture: the float pixels are the same
+      else tools.onPixels(feed.ended);
       $('#v-placeholder').hidden = true;
       $('#viewer').dataset.tiles = String(feed.tiles);
     } else if (type === 'status') {
@@ -86,6 +90,7 @@ const viewer = {
     } else if (type === 'end') {
       $('#viewer').dataset.ended = 'true';
       if (feed.painted) tools.onPixels(true);
+      showPicture();
       const st = feed.status && feed.status.state;
       if (!feed.painted && !this.keepPicture) {
         $('#v-placeholder').textContent = st === 'cancelled' ? 'No image: the job was cancelled.'
@@ -99,6 +104,7 @@ const viewer = {
       $('#v-more-form').hidden = true;
       setLink($('#v-png'), null);
       setLink($('#v-exr'), null);
+      resetDenoise();
       $('#v-placeholder').hidden = false;
       $('#v-placeholder').textContent = 'This job no longer exists on the server.';
       $('#viewer').dataset.state = 'gone';
@@ -143,6 +149,7 @@ const viewer = {
     const hasImage = s.state === 'done' || (this.feed && this.feed.painted);
     setLink($('#v-png'), hasImage ? s.images.png : null, `render-${s.id}.png`);
     setLink($('#v-exr'), hasImage ? s.images.exr : null, `render-${s.id}.exr`);
+    showDenoise(s, hasImage);
   },
 
   // "Render more": a finished job whose film is kept continues, to its own spp when it stopped
@@ -270,6 +277,7 @@ function init() {
   initViewerTools();
   initCamera();
   initCompare();
+  initDenoise();
   let resizeTimer = null;
   window.addEventListener('resize', () => {
     clearTimeout(resizeTimer);
@@ -294,6 +302,7 @@ async function start() {
     updateConn();
     await new Promise((r) => setTimeout(r, 1000));
   }
+  checkDenoiser();
   await refreshJobs();
   const m = location.hash.match(/job=([0-9a-f]+)/);
   if (m) viewer.show(m[1]);

@@ -155,12 +155,15 @@ async function dropPreview() {
   await deleteJob(id);
 }
 
-// The shown job's scene and settings at a quarter of its size (16 px a side at least), a few spp.
+// The shown job's scene and settings at a quarter of its size (16 px a side at least), a few spp;
+// denoised at preview quality where the job is denoised (no final-quality pass, no noise estimate).
 function previewSpec(view) {
   const { spec, width, height } = nav.base;
   const k = Math.min(1, Math.max(0.25, PREVIEW_MIN / Math.min(width, height)));
-  return { ...spec, width: Math.max(1, Math.round(width * k)), height: Math.max(1, Math.round(height * k)),
+  const preview = { ...spec, width: Math.max(1, Math.round(width * k)), height: Math.max(1, Math.round(height * k)),
     spp: PREVIEW_SPP, adaptive: false, target_error: 0, time_limit: 0, camera: cameraOf(view) };
+  if (preview.denoise === 'final') preview.denoise = 'preview';
+  return preview;
 }
 
 // Keeps one preview of the latest view: the stale one goes before the next is submitted, so

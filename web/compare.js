@@ -1,10 +1,13 @@
 // Compare two jobs: picked in the job list or a sweep's cells, shown side by side, with a wipe
 // (A left of the divider, B right of it) or as their difference in false colour (tev's absolute
 // and relative error, from the float pixels), live while they render, and the settings that differ.
+// A denoised job shows its denoised picture or its raw render (a pick per side), so that a job's
+// raw render can be set against its own denoised picture.
 'use strict';
 
 const compare = {
   ids: [],       // [A, B]: the first picked is A; a third pick drops the oldest
+  pictures: ['denoised', 'denoised'],  // what each side shows of a denoised job: 'denoised' or 'raw'
   sides: [],     // {id, feed, view}
   mode: 'side',  // or 'wipe', 'diff'
   metric: 'abs', // the difference: 'abs' |A - B| or 'rel' |A - B| / (B + 0.01)
@@ -22,8 +25,9 @@ function falseColour(t) {
 }
 
 // Spec fields in the order the difference list shows them; others follow by name.
-const COMPARE_ORDER = ['scene', 'size', 'spp', 'max_depth', 'aperture', 'focal_distance', 'light_samples',
-  'camera', 'keep_fov', 'frame_scene', 'adaptive', 'adaptive_tolerance', 'target_error', 'time_limit', 'seed', 'caustic_tracing'];
+const COMPARE_ORDER = ['scene', 'picture', 'size', 'spp', 'max_depth', 'aperture', 'focal_distance', 'light_samples',
+  'camera', 'keep_fov', 'frame_scene', 'adaptive', 'adaptive_tolerance', 'target_error', 'time_limit', 'seed', 'caustic_tracing',
+  'denoise'];
 
 function isCompared(id) { return compare.ids.includes(id); }
 
@@ -32,9 +36,18 @@ function toggleCompare(id, on) {
   compare.ids = compare.ids.filter((x) => x !== id);
   if (on) compare.ids.push(id);
   if (compare.ids.length > 2) compare.ids = compare.ids.slice(-2);
+  compare.pictures = ['denoised', 'denoised'];
   syncComparePicks();
   if (compare.ids.length === 2) showCompare();
   else hideCompare(false);
+}
+
+// A denoised job against itself: its denoised picture as A, its raw render as B.
+function compareRawDenoised(id) {
+  compare.ids = [id, id];
+  compare.pictures = ['denoised', 'raw'];
+  syncComparePicks();
+  showCompare();
 }
 
 // Every "compare" checkbox (job rows, sweep cells) shows whether its job is picked, and which side.
@@ -53,25 +66,54 @@ function showCompare() {
   hideCompare(false);
   const [a, b] = compare.ids;
   compare.sides = [a, b].map((id, k) => {
-    const side = { id, canvas: $(k === 0 ? '#compare-a' : '#compare-b'), feed: feedFor(id) };
+    const side = { id, name: k === 0 ? 'A' : 'B', canvas: $(k === 0 ? '#compare-a' : '#compare-b'), feed: feedFor(id),
+      picture: compare.pictures[k] };
     side.view = {
       onFeed(type, feed, rect) {
         if (type === 'size') clearCanvas(side.canvas, feed.canvas.width, feed.canvas.height);
-        else if (type === 'pixels') syncCanvas(side.canvas, feed, rect);
-        else if (type === 'status') listDifferences();
+        else if (type === 'pixels') syncCanvas(side.canvas, feed, rect, side.picture);
+        else if (type === 'status') { listDifferences(); showSidePictures(); }
         if (type === 'pixels' || type === 'end') side.stale = true;
         compare.schedule();
       },
     };
-    $(k === 0 ? '#compare-a-label' : '#compare-b-label').textContent = `${k === 0 ? 'A' : 'B'} · job ${shortId(id)}`;
     side.feed.attach(side.view);
     return side;
   });
+  showSidePictures();
   $('#compare').hidden = false;
   listDifferences();
   compare.schedule();
   $('#compare').scrollIntoView({ behavior: 'smooth', block: 'nearest' });
 }
+
+// Each side's label, and its picture pick where its job is denoised.
+function showSidePictures() {
+  compare.sides.forEach((side, k) => {
+    const dn = side.feed.status && side.feed.status.denoise;
+    const pick = k === 0 ? '#compare-a-picture' : '#compare-b-picture';
+    $(`${pick}-box`).hidden = !dn;
+    $(pick).value = side.picture;
+    const picture = dn ? ` · ${side.picture}` : '';
+    $(k === 0 ? '#compare-a-label' : '#compare-b-label').textContent = `${side.name} · job ${shortId(side.id)}${picture}`;
+    $(k === 0 ? '#compare .tag.a' : '#compare .tag.b').textContent = `${side.name}${picture}`;
+  });
+}
+
+// A side now shows its job's other picture.
+function setSidePicture(k, picture) {
+  const side = compare.sides[k];
+  if (!side) return;
+  compare.pictures[k] = side.picture = picture;
+  if (side.feed.painted) syncCanvas(side.canvas, side.feed, null, picture);
+  side.stale = true;
+  showSidePictures();
+  listDifferences();
+  compare.schedule();
+}
+
+// Whether a side shows a denoised picture: its pixels are 8-bit only (no float pixels of it here).
+function showsDenoised(side) { return side.picture === 'denoised' && Boolean(side.feed.denoised); }
 
 function hideCompare(clearPicks = true) {
   compare.sides.forEach((s) => { s.feed.detach(s.view); clearTimeout(s.timer); });
@@ -125,11 +167,11 @@ function needPixels(side) {
   })();
 }
 
-// A side's linear RGB: its float pixels, else (none kept) its 8-bit picture through the inverse of
-// the course's PNG curve. {w, h, rgb(i, c)}, or null while loading.
-function linearOf(side) {
-  if (side.px) return { w: side.px.w, h: side.px.h, rgb: (i, c) => side.px.data[4 * i + c], exact: true };
-  if (!side.missing || !side.feed.painted) return null;
+// A side's linear RGB: its float pixels, else (none kept, or `eightBit`) its 8-bit picture through
+// the inverse of the course's PNG curve. {w, h, rgb(i, c)}, or null while loading.
+function linearOf(side, eightBit) {
+  if (side.px && !eightBit) return { w: side.px.w, h: side.px.h, rgb: (i, c) => side.px.data[4 * i + c], exact: true };
+  if (!side.feed.painted || (!eightBit && !side.missing)) return null;
   const c = side.canvas, bytes = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
   return { w: c.width, h: c.height, rgb: (i, k) => (bytes[4 * i + k] / 255) ** 2.2 / Math.SQRT2, exact: false };
 }
@@ -138,8 +180,10 @@ function linearOf(side) {
 // (a few fireflies do not wash out the rest); the legend says the scale.
 function drawDiff() {
   if (compare.sides.length !== 2 || compare.mode !== 'diff') return;
-  compare.sides.forEach(needPixels);
-  const [a, b] = compare.sides.map(linearOf);
+  // A denoised picture has 8-bit pixels only: then both sides are compared as 8-bit, alike.
+  const eightBit = compare.sides.some(showsDenoised);
+  if (!eightBit) compare.sides.forEach(needPixels);
+  const [a, b] = compare.sides.map((side) => linearOf(side, eightBit));
   const stats = $('#compare-diff-stats'), out = $('#compare-diff-canvas');
   showDiffRamp();
   if (!a || !b) {
@@ -180,7 +224,8 @@ function drawDiff() {
   ctx.putImageData(img, 0, 0);
   $('#compare-diff-max').textContent = fmtNum(top > 0 ? top : 0, 3);
   stats.textContent = `${rel ? 'relative' : 'absolute'} error: mean ${fmtNum(sum / n, 3)}, largest ${fmtNum(sorted[n - 1], 3)}` +
-    (a.exact && b.exact ? '' : ' (from the 8-bit pictures: a job kept no float pixels)');
+    (a.exact && b.exact ? '' : eightBit ? ' (from the 8-bit pictures: a denoised picture has no float pixels here)'
+      : ' (from the 8-bit pictures: a job kept no float pixels)');
   $('#compare-stage').dataset.diff = compare.metric;
 }
 
@@ -224,12 +269,14 @@ function listDifferences() {
   const specs = st.map((s) => s.spec || {});
   const keys = new Set([...Object.keys(specs[0]), ...Object.keys(specs[1]), 'size']);
   ['width', 'height'].forEach((k) => keys.delete(k));
+  if (st.some((s) => s.denoise)) keys.add('picture');
   const ordered = [...COMPARE_ORDER.filter((k) => keys.has(k)), ...[...keys].filter((k) => !COMPARE_ORDER.includes(k)).sort()];
   const fmt = (v, k) => (k === 'camera' ? fmtCamera(v) : v === undefined ? '–' : v === null ? 'none'
     : typeof v === 'boolean' ? (v ? 'yes' : 'no') : String(v));
   let n = 0;
   for (const k of ordered) {
-    const [va, vb] = [0, 1].map((i) => compareValue(specs[i], st[i], k));
+    const [va, vb] = [0, 1].map((i) => (k === 'picture' ? (st[i].denoise ? compare.sides[i].picture : undefined)
+      : compareValue(specs[i], st[i], k)));
     if (JSON.stringify(va) === JSON.stringify(vb)) continue;
     const tr = document.createElement('tr');
     tr.dataset.field = k;
@@ -257,8 +304,11 @@ function initCompare() {
   $('#compare-wipe').addEventListener('input', () => compare.schedule());
   $('#compare-metric').addEventListener('change', (e) => { compare.metric = e.target.value; compare.schedule(); });
   $('#compare-close').addEventListener('click', () => hideCompare());
+  ['#compare-a-picture', '#compare-b-picture'].forEach((sel, k) =>
+    $(sel).addEventListener('change', (e) => setSidePicture(k, e.target.value)));
   $('#compare-swap').addEventListener('click', () => {
     compare.ids.reverse();
+    compare.pictures.reverse();
     syncComparePicks();
     showCompare();
   });

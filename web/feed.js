@@ -1,5 +1,7 @@
 // Feed: one job's pixels, status and error history from its event stream (one EventSource, one
-// decode per job, however many canvases show it), and copying them into a canvas.
+// decode per job, however many canvases show it), and copying them into a canvas. A denoised job
+// has two pictures: the raw render (image and tile events) and the denoised one (the last
+// 'denoised' event with the raw tiles since painted over it, so it refreshes at pass ends).
 'use strict';
 
 class Feed {
@@ -8,8 +10,9 @@ class Feed {
     this.views = new Set();
     this.status = null;
     this.history = [];
-    this.canvas = document.createElement('canvas');
+    this.canvas = document.createElement('canvas');  // the raw render
     this.ctx = this.canvas.getContext('2d');
+    this.denoised = null;  // a canvas once a denoised picture came, same size as the raw one
     this.chain = Promise.resolve();  // decodes run in parallel, draws in arrival order
     this.painted = false;
     this.tiles = 0;
@@ -125,6 +128,12 @@ class Feed {
       const d = JSON.parse(e.data);
       this.paint(d.png, d.x, d.y, d.w, d.h, false);
     });
+    es.addEventListener('denoised', (e) => {
+      const decoded = decodePng(JSON.parse(e.data).png);
+      decoded.catch(() => {});
+      this.chain = this.chain.then(() => decoded).then((bmp) => this.setDenoised(bmp))
+        .catch((err) => console.warn(`job ${this.id}: cannot draw a denoised picture`, err));
+    });
     es.addEventListener('status', (e) => {
       const s = JSON.parse(e.data);
       this.chain = this.chain.then(() => this.setStatus(s));
@@ -153,7 +162,27 @@ class Feed {
     this.canvas.width = w;
     this.canvas.height = h;
     this.painted = false;
+    this.denoised = null;
     this.emit('size');
+  }
+
+  // The picture a view asks for: 'raw', or 'denoised' (the raw one until a denoised one came).
+  picture(which) {
+    return which === 'raw' || !this.denoised ? this.canvas : this.denoised;
+  }
+
+  // A whole denoised picture: the denoised view starts over from it.
+  setDenoised(bmp) {
+    const w = this.canvas.width, h = this.canvas.height;
+    const fits = bmp.width === w && bmp.height === h;  // else from before a resize: stale
+    if (fits && !this.denoised) {
+      this.denoised = document.createElement('canvas');
+      this.denoised.width = w;
+      this.denoised.height = h;
+    }
+    if (fits) this.denoised.getContext('2d').drawImage(bmp, 0, 0);
+    if (bmp.close) bmp.close();
+    if (fits) this.emit('pixels', { x: 0, y: 0, w, h, denoised: true });
   }
 
   paint(b64, x, y, w, h, whole) {
@@ -162,6 +191,8 @@ class Feed {
     this.chain = this.chain.then(() => decoded).then((bmp) => {
       if (whole) this.setSize(w, h);
       this.ctx.drawImage(bmp, x, y);
+      // Raw tiles cover the denoised picture as they come, until the next pass end's.
+      if (this.denoised && !whole) this.denoised.getContext('2d').drawImage(bmp, x, y);
       if (bmp.close) bmp.close();
       this.painted = true;
       if (!whole) this.tiles += 1;
@@ -169,18 +200,19 @@ class Feed {
     }).catch((err) => console.warn(`job ${this.id}: cannot draw a tile`, err));
   }
 
+  // The stored image; a job with denoised pictures has two: image.png is the denoised one.
   async loadStoredImage() {
-    try {
-      const res = await fetch(`/api/jobs/${this.id}/image.png`, { cache: 'no-store', headers: authHeaders() });
-      if (!res.ok) return;
-      const bmp = await createImageBitmap(await res.blob(), { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
-      this.setSize(bmp.width, bmp.height);
-      this.ctx.drawImage(bmp, 0, 0);
-      this.painted = true;
-      this.emit('pixels', { x: 0, y: 0, w: bmp.width, h: bmp.height });
-    } catch (e) {
-      // No image (yet): the view keeps its placeholder.
-    }
+    const dn = this.status && this.status.denoise;
+    const denoised = dn && dn.frames > 0;
+    const bmp = await fetchBitmap(denoised ? dn.raw_images.png : `/api/jobs/${this.id}/image.png`);
+    if (!bmp) return;  // no image (yet): the view keeps its placeholder
+    this.setSize(bmp.width, bmp.height);
+    this.ctx.drawImage(bmp, 0, 0);
+    this.painted = true;
+    this.emit('pixels', { x: 0, y: 0, w: bmp.width, h: bmp.height });
+    if (!denoised) return;
+    const dbmp = await fetchBitmap(`/api/jobs/${this.id}/image.png`);
+    if (dbmp) this.setDenoised(dbmp);
   }
 
   setStatus(s) {
@@ -212,6 +244,17 @@ class Feed {
   }
 }
 
+// An image of the API as an ImageBitmap, its bytes as they are; null when there is none.
+async function fetchBitmap(url) {
+  try {
+    const res = await fetch(url, { cache: 'no-store', headers: authHeaders() });
+    if (!res.ok) return null;
+    return await createImageBitmap(await res.blob(), { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
+  } catch (e) {
+    return null;
+  }
+}
+
 function feedFor(id) {
   let f = state.feeds.get(id);
   if (!f) {
@@ -221,11 +264,12 @@ function feedFor(id) {
   return f;
 }
 
-// Copies the feed's pixels into a view's canvas (same size, so an exact copy).
-function syncCanvas(canvas, feed, rect) {
+// Copies the feed's picture ('denoised' where it has one, or 'raw') into a view's canvas (same
+// size, so an exact copy).
+function syncCanvas(canvas, feed, rect, which = 'denoised') {
   const ctx = canvas.getContext('2d');
   if (!rect) rect = { x: 0, y: 0, w: feed.canvas.width, h: feed.canvas.height };
-  ctx.drawImage(feed.canvas, rect.x, rect.y, rect.w, rect.h, rect.x, rect.y, rect.w, rect.h);
+  ctx.drawImage(feed.picture(which), rect.x, rect.y, rect.w, rect.h, rect.x, rect.y, rect.w, rect.h);
 }
 
 function clearCanvas(canvas, w, h) {

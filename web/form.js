@@ -7,7 +7,7 @@
 const FIELDS = {
   scene: 'select', max_depth: 'int', light_samples: 'int', aperture: 'num', focal_distance: 'num',
   spp: 'int', width: 'int', height: 'int', seed: 'int', time_limit: 'num', target_error: 'num', adaptive: 'bool',
-  adaptive_tolerance: 'num', caustic_tracing: 'bool',
+  adaptive_tolerance: 'num', caustic_tracing: 'bool', denoise: 'select',
 };
 
 // The framing select sets two job fields (the API refuses both true): value -> fields, and what it does.
@@ -235,6 +235,7 @@ function fillForm(spec) {
   $('#f-framing').value = framingOf(spec);
   showFramingHint();
   showSceneSummary();
+  syncDenoiseControl();  // a job's denoise stays off where this server cannot denoise
   setFormCamera(spec.camera ? { scene: spec.scene, camera: spec.camera } : null);
 }
 

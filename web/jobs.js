@@ -14,6 +14,7 @@ const OTHER_SETTINGS = [
   ['time_limit', (v) => `limit ${v} s`],
   ['seed', (v) => `seed ${v}`],
   ['caustic_tracing', (v) => (v ? 'caustics' : 'no caustics')],
+  ['denoise', (v) => (v === 'off' ? 'not denoised' : `denoise ${v}`)],
   ['frame_scene', (v) => (v ? 'fitted to the scene' : 'course framing')],
   ['keep_fov', (v) => (v ? 'whole course view' : 'course crop')],
   ['camera', (v) => `camera ${fmtCamera(v)}`],
@@ -74,6 +75,8 @@ function rowFor(id) {
     '<button type="button" data-action="cancel" class="danger">Cancel</button>' +
     '<button type="button" data-action="delete" class="danger" title="Delete the job and its images">Delete</button>' +
     '<a class="button" data-action="png">PNG</a><a class="button" data-action="exr">EXR</a>' +
+    '<span class="raw-links" title="The raw render, before denoising"><a class="button" data-action="raw-png">raw PNG</a>' +
+    '<a class="button" data-action="raw-exr">raw EXR</a></span>' +
     '<label class="compare-pick" title="Compare two jobs: the first picked is A"><input type="checkbox" data-action="compare"> compare</label></td>';
   jobList.rows.set(id, tr);
   return tr;
@@ -121,6 +124,7 @@ function renderJobs(jobs) {
     const img = hasImage(j);
     setLink(tr.querySelector('[data-action=png]'), img ? j.images.png : null, `render-${j.id}.png`);
     setLink(tr.querySelector('[data-action=exr]'), img ? j.images.exr : null, `render-${j.id}.exr`);
+    showRowDenoise(tr, j, img);
     if (body.children[i] !== tr) body.insertBefore(tr, body.children[i] || null);
   });
   for (const [id, tr] of jobList.rows) {
@@ -131,6 +135,19 @@ function renderJobs(jobs) {
   $('#jobs-empty').hidden = jobs.length > 0;
   $('#jobs-more').hidden = !jobList.more;
   highlightRow();
+}
+
+// A denoised job's row: its images are the denoised ones, its raw ones beside them, and its error
+// estimate is the raw render's (the denoised noise estimate in the cell's tooltip).
+function showRowDenoise(tr, j, img) {
+  const dn = j.denoise;
+  tr.querySelector('.raw-links').hidden = !dn;
+  for (const ext of ['png', 'exr']) {
+    setLink(tr.querySelector(`[data-action=raw-${ext}]`), dn && img ? dn.raw_images[ext] : null, `render-${j.id}-raw.${ext}`);
+    tr.querySelector(`[data-action=${ext}]`).title = dn ? 'The denoised image' : '';
+  }
+  const noise = dn && Number.isFinite(dn.noise_estimate) ? `; denoised noise estimate ${fmtNum(dn.noise_estimate, 3)} (halves, excludes bias)` : '';
+  tr.querySelector('td.error-est').title = dn ? `The raw render's error estimate${noise}` : '';
 }
 
 // A cell is marked where its setting differs from the job above or below of the same scene: a
@@ -251,6 +268,7 @@ async function refreshJobs() {
 // The server is back: reload what may have changed, and restart the streams that gave up.
 function onReconnected() {
   if (!state.scenes.length) loadScenes();
+  checkDenoiser();  // the server may have come back with or without its denoiser
   for (const f of state.feeds.values()) {
     if (f.gone || f.ended) continue;
     if (!f.es || f.es.readyState === EventSource.CLOSED) {

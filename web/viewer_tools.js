@@ -165,10 +165,11 @@ const tools = {
       if (this.data && this.data.id === viewer.id) this.paint();
       if (!this.data || this.stale) this.request();
     } else if (viewer.feed && viewer.feed.painted) {
-      syncCanvas($('#v-canvas'), viewer.feed);
+      syncCanvas($('#v-canvas'), viewer.feed, null, denoiseView.choice);
       $('#v-tools').dataset.painted = 'stream';
     }
     this.showLegend();
+    showPicture();
   },
 
   showLegend() {
@@ -314,7 +315,9 @@ const tools = {
     if (this.stale) this.request();
     const i = 4 * (y * d.w + x);
     const f = (v) => v.toPrecision(4);
-    out.textContent = `(${x}, ${y})  R ${f(d.px[i])}  G ${f(d.px[i + 1])}  B ${f(d.px[i + 2])}  · ${d.px[i + 3]} samples`;
+    // The float pixels are the raw render's, whichever picture a denoised job shows.
+    const raw = viewer.feed && viewer.feed.status && viewer.feed.status.denoise ? ' (raw render)' : '';
+    out.textContent = `(${x}, ${y})  R ${f(d.px[i])}  G ${f(d.px[i + 1])}  B ${f(d.px[i + 2])}  · ${d.px[i + 3]} samples${raw}`;
     Object.assign(out.dataset, { x, y, r: d.px[i], g: d.px[i + 1], b: d.px[i + 2], n: d.px[i + 3] });
   },
 };

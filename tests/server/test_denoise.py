@@ -82,11 +82,13 @@ def test_a_denoised_job_streams_denoised_frames_and_keeps_its_raw_render(servers
     assert plain["denoise"] is None
     assert api.get(f"/api/jobs/{plain['id']}/image.png?raw=1").content == api.get(f"/api/jobs/{plain['id']}/image.png").content
 
-    # The record survives a restart.
+    # The record survives a restart, and /pixels (the page's tools) stays the raw render's.
+    pixels = api.get(f"/api/jobs/{job['id']}/pixels").content
     srv.terminate()
     srv = servers("denoise", threads=2)
     again = srv.api.job(job["id"])
     assert again["denoise"]["noise_estimate"] == den["noise_estimate"] and again["denoise"]["frames"] == den["frames"]
+    assert srv.api.get(f"/api/jobs/{job['id']}/pixels").content == pixels
 
 
 def test_without_the_denoiser_the_field_is_refused_with_422(servers):

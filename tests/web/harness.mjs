@@ -34,12 +34,12 @@ try {
 // Generous: ctest may run the heavy image tests beside these on 2 cores.
 export const WAIT = Number(process.env.PT_WEB_WAIT_MS) || 90_000;
 
-// A render-server on `port` (0: any) serving web/, with more `args`; resolves {proc, url, port}
-// once it listens.
-export function startServer(dataDir, port = 0, args = []) {
+// A render-server on `port` (0: any) serving web/, with more `args` and environment variables
+// `env` (say PT_OIDN_LIB, to leave it without a denoiser); resolves {proc, url, port} once it listens.
+export function startServer(dataDir, port = 0, args = [], env = {}) {
   return new Promise((resolve, reject) => {
     const proc = spawn(serverBin, ['--port', String(port), '--data', dataDir, '--web', path.join(sourceDir, 'web'), ...args],
-      { stdio: ['ignore', 'pipe', 'pipe'] });
+      { stdio: ['ignore', 'pipe', 'pipe'], env: { ...process.env, ...env } });
     let out = '', err = '';
     const timer = setTimeout(() => { proc.kill('SIGKILL'); reject(new Error(`render-server did not start: ${out}${err}`)); }, 20_000);
     proc.stdout.on('data', (d) => {
