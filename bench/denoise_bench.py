@@ -92,7 +92,8 @@ def parse_error_log(text):
         except (TypeError, ValueError):
             return math.nan
 
-    return [{c: number(row.get(c)) for c in LOG_COLUMNS + ("preview_denoise_seconds",)} for row in reader]
+    return [{c: number(row.get(c)) for c in LOG_COLUMNS + ("preview_denoise_seconds", "preview_rel_mse")}
+            for row in reader]
 
 
 def reference_noise(raw_err, spp, ref_spp):
@@ -115,6 +116,30 @@ def curves(rows, ref_spp):
         raw.append((r["seconds"], e_raw))
         den.append((r["seconds"] + r["denoise_seconds"], e_den))
     return raw, den
+
+
+def fast_curve(rows, ref_spp):
+    """The fast-quality denoise's (seconds, corrected relative MSE) points (a job's denoise
+    "preview"), from the log's preview columns; empty for a log without them."""
+    out = []
+    for r in rows:
+        d, e = r.get("preview_denoise_seconds", math.nan), r.get("preview_rel_mse", math.nan)
+        if not (math.isnan(d) or math.isnan(e)):
+            out.append((r["seconds"] + d, corrected(r["rel_mse"], e, r["spp"], ref_spp)[1]))
+    return out
+
+
+FAST_HEAD = ("| scene | ours fast-denoised t(1e-2) | speed-up over raw | ours fast-denoised t(1e-3) | speed-up over raw |\n"
+             "|---|---|---|---|---|")
+
+
+def fast_row(name, raw, fast):
+    """One markdown row of the fast-quality table: its times to each target and its speed-up over raw."""
+    cols = [name]
+    for target in TARGETS:
+        r, f = time_to_error(raw, target), time_to_error(fast, target)
+        cols += [format_time(f), speed_up(r, f)]
+    return "| " + " | ".join(cols) + " |"
 
 
 def time_to_error(points, target):
@@ -409,11 +434,14 @@ def main():
     cyc_cost = sum(spp_ladder(args.cycles_max_spp)) * 2 + args.ref_spp
     work = Work(sum(Work.OURS_COST * (args.spp + args.ref_spp) + (cyc_cost if kind == "glb" else 0)
                     for _, _, kind in scenes))
-    rows, notes = [], []
+    rows, notes, fast_rows = [], [], []
     for name, path, kind in scenes:
         depth = depth_for(args, kind, name)
         log_rows = run_ours(args, name, path, kind, depth, work)
         ours = curves(log_rows, args.ref_spp)
+        fast = fast_curve(log_rows, args.ref_spp)
+        if fast:
+            fast_rows.append(fast_row(name, ours[0], fast))
         cost = denoise_cost(log_rows)
         notes.append(f"{name} (-m {depth}): our denoise {cost['median']:.3g} s a pass (median of {len(log_rows)}; the "
                      f"first {cost['first']:.3g} s, device set-up included) = {cost['ratio']:.2f} x the median pass's "
@@ -434,11 +462,17 @@ def main():
             labels = ("ours raw", "ours denoised", "Cycles", "Cycles+OIDN")
             for label, points in zip(labels, [*ours, *(cycles or ())]):
                 print(curve_lines(label, points))
+            if fast:
+                print(curve_lines("ours fast", fast))
         rows.append(table_row(name, ours, cycles))
     clear()
     print()
     print(TABLE_HEAD)
     print("\n".join(rows))
+    if fast_rows:  # OIDN's fast quality, without cleaning the features first: what denoise "preview" gives
+        print()
+        print(FAST_HEAD)
+        print("\n".join(fast_rows))
     print()
     print("\n".join(notes))
 

@@ -155,14 +155,15 @@ struct PathState {
     depth_left = max_depth;
     bounce = 0;
   }
-  // A diffuse vertex's start and its bounce, as the lanes' text takes them at any width: its light
-  // sampling weighed by the throughput it arrived with, then the bounce's bookkeeping (vertex
-  // number `bounce`, its pdf, at point p).
+  // The features of the vertex the path stands at (or of the background it left to).
   void set_features(Vec3 surface_albedo, Vec3 facing_normal) {
     const Vec3 tint = min(beta, Vec3(1.0f));  // the delta bounces' colour so far
     albedo = surface_albedo * tint, normal = facing_normal;
     want_features = false;
   }
+  // A diffuse vertex's start and its bounce, as the lanes' text takes them at any width: its light
+  // sampling weighed by the throughput it arrived with, then the bounce's bookkeeping (vertex
+  // number `bounce`, its pdf, at point p).
   void start_diffuse_vertex() {
     has_direct = true;
     direct_beta = beta;

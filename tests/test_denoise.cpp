@@ -262,3 +262,19 @@ TEST(DenoiseCli, ANonFiniteDenoiserOutputNeverReachesTheImage) {
   const ImageRGB img = read_image(out);
   for (const Vec3& v : img.pixels) ASSERT_TRUE(is_finite(v));
 }
+
+// A non-finite feature (a NaN normal from a degenerate triangle) counts as zero, as a non-finite
+// sample does: nothing non-finite reaches the denoiser.
+TEST(DenoiseFilm, NonFiniteFeaturesAndSamplesNeverReachTheDenoiser) {
+  Film film(2, 1, 4, AdaptiveRule{false}, false, true);
+  uint64_t nonfinite = 0;
+  film.add_sample(0, 0, Vec3(NAN, 1, 1), nonfinite);
+  film.add_features(0, Vec3(NAN, 0.5f, 0.5f), Vec3(0, INFINITY, 0));
+  film.add_sample(0, 1, Vec3(0.5f), nonfinite);
+  film.add_features(0, Vec3(0.5f), Vec3(0, 0, 1));
+  EXPECT_EQ(nonfinite, 1u);
+  const FilmFeatures f = film.features();
+  EXPECT_EQ(f.albedo.at(0, 0), Vec3(0.25f));  // (0 + 0.5) / 2
+  EXPECT_EQ(f.normal.at(0, 0), Vec3(0, 0, 0.5f));
+  for (const Vec3& v : film.image().pixels) EXPECT_TRUE(is_finite(v));
+}

@@ -133,7 +133,8 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
       std::fprintf(log, "seconds,spp,error_estimate%s%s\n", reference.pixels.empty() ? "" : ",rmse,rel_mse",
                    !o.denoise                 ? ""
                    : reference.pixels.empty() ? ",denoise_seconds,preview_denoise_seconds"
-                                              : ",denoise_seconds,denoised_rel_mse,preview_denoise_seconds");
+                                              : ",denoise_seconds,denoised_rel_mse,preview_denoise_seconds,"
+                                                "preview_rel_mse");
     }
     ProgressBar bar("Rendering", !o.quiet);
     double pixels = double(session.width()) * session.height();
@@ -200,7 +201,9 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
         std::fprintf(log, ",%.6g", d.seconds);
         if (!reference.pixels.empty()) std::fprintf(log, ",%.6g", d.ok ? relative_mse(d.image, reference) : NAN);
         // And what the window's and the page's pictures at pass ends cost (fast quality).
-        std::fprintf(log, ",%.6g", denoise_film(session.film(), DenoiseQuality::preview, o.params.threads, false).seconds);
+        const DenoisedFilm p = denoise_film(session.film(), DenoiseQuality::preview, o.params.threads, false);
+        std::fprintf(log, ",%.6g", p.seconds);
+        if (!reference.pixels.empty()) std::fprintf(log, ",%.6g", p.ok ? relative_mse(p.image, reference) : NAN);
       }
       std::fprintf(log, "\n");
       std::fflush(log);
@@ -238,14 +241,15 @@ int pt::pathtracer_main(const std::vector<std::string>& args, const char* argv0,
       std::printf("%s: %d checkpoint%s written in %.3f s\n", o.checkpoint.c_str(), checkpoints->saves(),
                   checkpoints->saves() == 1 ? "" : "s", checkpoints->save_seconds());
     // The estimate is the raw render's; the denoised image's is the spread of its denoised halves.
-    std::string denoise_text;
+    char denoise_text[160] = "";
     if (denoised.ok)
-      denoise_text = ", denoised in " + std::to_string(denoised.seconds).substr(0, 5) + " s (noise estimate " +
-                     format_error_estimate(denoised.noise) + " from its denoised halves, bias not included)";
+      std::snprintf(denoise_text, sizeof denoise_text,
+                    ", denoised in %.3f s (noise estimate %s from its denoised halves, bias not included)",
+                    denoised.seconds, format_error_estimate(denoised.noise).c_str());
     std::printf("%s: %dx%d, %.1f spp avg (max %d), %.2f s, %.3g samples/s, %.3g rays/s, error estimate %s%s%s%s\n",
                 o.output.c_str(), session.width(), session.height(), st.samples / pixels, o.params.spp, st.seconds,
                 st.samples / st.seconds, st.rays / st.seconds, (err_text + (o.denoise ? " (raw)" : "")).c_str(),
-                denoise_text.c_str(),
+                denoise_text,
                 why == StopReason::finished ? "" : (std::string(", ") + stop_reason_name(why)).c_str(),
                 st.nonfinite ? (", " + std::to_string(st.nonfinite) + " non-finite samples dropped").c_str() : "");
     return 0;

@@ -19,8 +19,8 @@ class Report(unittest.TestCase):
     def test_the_error_log_reads_as_numbers(self):
         rows = db.parse_error_log(LOG)
         self.assertEqual(len(rows), 3)
-        preview = rows[1].pop("preview_denoise_seconds")  # an older log has no such column: NaN
-        self.assertTrue(math.isnan(preview))
+        for column in ("preview_denoise_seconds", "preview_rel_mse"):  # an older log has no such column: NaN
+            self.assertTrue(math.isnan(rows[1].pop(column)))
         self.assertEqual(rows[1], dict(seconds=0.004782, spp=2.0, rel_mse=0.159724, denoise_seconds=0.0260627,
                                        denoised_rel_mse=0.040207))
         self.assertTrue(math.isnan(rows[2]["denoised_rel_mse"]))
@@ -98,6 +98,16 @@ class Report(unittest.TestCase):
         self.assertAlmostEqual(cost["pass_median"], 1.5)  # passes of 1, 1, 2 and 4 s
         self.assertAlmostEqual(cost["ratio"], 0.1)
         self.assertAlmostEqual(cost["spp"], 0.15)  # 1 spp a second
+
+    def test_the_fast_curve_and_its_row(self):
+        rows = [dict(seconds=s, spp=n, rel_mse=e, preview_denoise_seconds=0.5, preview_rel_mse=f)
+                for s, n, e, f in [(1.0, 1, 0.1, 0.01), (2.0, 2, 0.05, 0.001)]]
+        fast = db.fast_curve(rows, 1024)
+        self.assertEqual([t for t, _ in fast], [1.5, 2.5])
+        self.assertAlmostEqual(fast[0][1], 0.01 - 0.1 * 1 / 1025)  # the reference's noise out
+        self.assertEqual(db.fast_curve([dict(seconds=1.0, spp=1, rel_mse=0.1)], 1024), [])
+        row = db.fast_row("x", [(1.0, 0.1), (100.0, 0.001)], fast)
+        self.assertEqual(row.count("|"), db.FAST_HEAD.splitlines()[0].count("|"))
 
     def test_the_preview_cost_per_pass(self):
         rows = [dict(seconds=s, spp=n, preview_denoise_seconds=d) for s, n, d in
