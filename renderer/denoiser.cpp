@@ -14,6 +14,11 @@
 #include <type_traits>
 #include <vector>
 
+// OIDN's handle types, declared as its C header declares them (at global scope), so that a call
+// through the pointers below has the library's own function type.
+struct OIDNDeviceImpl;
+struct OIDNFilterImpl;
+
 namespace pt {
 
 const char* const kDenoiserInstallHint =
@@ -31,8 +36,8 @@ std::string oidn_version_problem(int version) {
 
 namespace {
 
-using Device = struct OIDNDeviceImpl*;
-using Filter = struct OIDNFilterImpl*;
+using Device = OIDNDeviceImpl*;
+using Filter = OIDNFilterImpl*;
 constexpr int kCpuDevice = 1;   // OIDN_DEVICE_TYPE_CPU
 constexpr int kFloat3 = 3;      // OIDN_FORMAT_FLOAT3
 constexpr int kOutOfMemory = 4; // OIDN_ERROR_OUT_OF_MEMORY

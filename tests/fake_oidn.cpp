@@ -9,16 +9,18 @@
 #include <cstring>
 #include <string>
 
-namespace {
-struct Device {
+// The handle types at global scope, as OIDN's header and renderer/denoiser.cpp declare them: the
+// functions below then have the exact types the renderer calls them through (UBSan checks that).
+struct OIDNDeviceImpl {
   int error = 0;
 };
-struct Filter {
-  Device* device;
+struct OIDNFilterImpl {
+  OIDNDeviceImpl* device;
   float *color = nullptr, *output = nullptr;
   size_t bytes = 0;
 };
-}  // namespace
+using Device = OIDNDeviceImpl;
+using Filter = OIDNFilterImpl;
 
 extern "C" {
 Device* oidnNewDevice(int) { return new Device; }
