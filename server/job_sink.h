@@ -105,6 +105,20 @@ class JobStateSink : public JobSink {
   }
 
   void denoised(const pt::DenoisedFilm& d, double spp, bool final) override {
+    // The picture's linear and tone-mapped copies are made before taking the job's mutex, which
+    // watchers and the render threads' tiles also take.
+    std::vector<float> linear;
+    std::vector<uint8_t> display;
+    if (d.ok) {
+      const size_t n = d.image.pixels.size();
+      linear.resize(n * 3);
+      display.resize(n * 3);
+      for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) {
+          linear[i * 3 + c] = d.image.pixels[i][c];
+          display[i * 3 + c] = pt::tonemap_course(d.image.pixels[i][c]);
+        }
+    }
     Job& j = m_job;
     {
       std::lock_guard<std::mutex> lock(j.mutex);
@@ -112,14 +126,8 @@ class JobStateSink : public JobSink {
       if (!d.ok) {
         out.warning = d.error + "; the picture is the raw render";
       } else if (d.image.width == j.width && d.image.height == j.height) {
-        const size_t n = d.image.pixels.size();
-        out.linear.resize(n * 3);
-        out.display.resize(n * 3);
-        for (size_t i = 0; i < n; ++i)
-          for (int c = 0; c < 3; ++c) {
-            out.linear[i * 3 + c] = d.image.pixels[i][c];
-            out.display[i * 3 + c] = pt::tonemap_course(d.image.pixels[i][c]);
-          }
+        out.linear.swap(linear);
+        out.display.swap(display);
         out.spp = spp;
         out.seconds = d.seconds;
         ++out.frames;
