@@ -98,10 +98,14 @@ FilmPass FilmPass::decode(const std::string& bytes, int expect_width, int expect
     return is_finite(a) && is_finite(nn) && std::fabs(a.x) <= c && std::fabs(a.y) <= c && std::fabs(a.z) <= c &&
            std::fabs(nn.x) <= c && std::fabs(nn.y) <= c && std::fabs(nn.z) <= c;
   };
-  for (size_t i = 0; i < n; ++i)
-    if (p.samples[i] > p.count || !is_finite(p.sum[i]) || !std::isfinite(p.lum2[i]) ||
+  for (size_t i = 0; i < n; ++i) {
+    if (p.samples[i] > p.count)
+      throw std::runtime_error("film pass: pixel " + std::to_string(i) + " holds " + std::to_string(p.samples[i]) +
+                               " samples, more than the pass's " + std::to_string(p.count));
+    if (!is_finite(p.sum[i]) || !std::isfinite(p.lum2[i]) ||
         (h.has_caustics && !is_finite(p.caustic_sum[i])) || !feature_ok(i))
       throw std::runtime_error("film pass: pixel " + std::to_string(i) + " holds impossible values");
+  }
   return p;
 }
 

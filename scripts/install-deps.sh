@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libcpp-httplib-dev nlohmann-json3-dev libglfw3-dev
   libgl1-mesa-dri  # the window's OpenGL without a GPU (Mesa's llvmpipe)
   libhiredis-dev  # render-worker's Redis client (the scale-out queue)
+  libssl-dev  # the render farm's signatures (HMAC-SHA256, server/farm_security.cpp)
   python3-pip  # fetches the denoiser, Intel Open Image Denoise, from PyPI (scripts/install-oidn.sh)
 )
 # ... and what the tests add.
@@ -19,6 +20,8 @@ if [ "${1:-all}" != main ]; then
     chromium nodejs npm  # the web page's browser test (tests/web: playwright-core drives this Chromium)
     python3-venv python3-pip  # build/venv for the server tests (scripts/python-env.sh)
     redis-server  # the scale-out tests' Redis
+    spiped  # the scale-out tunnel test (an encrypted pipe to Redis, docs/scale-out.md)
+    iproute2 util-linux  # the two-host test: network namespaces joined by a veth pair
     clang libclang-rt-14-dev  # build-fuzz: libFuzzer and the sanitizer runtimes (scripts/fuzz.sh, asan.sh)
   )
 fi

@@ -57,6 +57,10 @@ bool well_formed_unknown_method(const httplib::Request& req) {
 
 }  // namespace
 
+bool authorized(const httplib::Request& req, const std::string& token) {
+  return token.empty() || auth_failure(req, token).empty();
+}
+
 void send_json(httplib::Response& res, int status, const json& body) {
   res.status = status;
   res.set_content(dump_json(body), "application/json");

@@ -87,5 +87,7 @@ void guarded(httplib::Response& res, F&& f) {
 // Installs the pre-routing checks, the Expect: 100-continue answer, the error and exception
 // handlers on `svr`.
 void install_guards(httplib::Server& svr, const ApiOptions& options);
+// Whether the request carries the server's --token (always true without one).
+bool authorized(const httplib::Request& req, const std::string& token);
 
 }  // namespace srv

@@ -95,6 +95,7 @@ JobManager::~JobManager() { stop(); }
 
 std::string JobManager::backend_name() const { return m_backend ? m_backend->name() : "embedded"; }
 int JobManager::live_workers() const { return m_backend ? m_backend->live_workers() : -1; }
+json JobManager::farm() const { return m_backend ? m_backend->farm() : json(); }
 
 std::string JobManager::job_dir(const std::string& id) const { return m_config.data_dir + "/jobs/" + id; }
 
@@ -118,7 +119,7 @@ void JobManager::start() {
   if (m_config.queue.empty() || m_config.queue == "embedded")
     m_backend = make_embedded_backend(m_scenes, m_config.threads);
   else
-    m_backend = make_redis_backend(m_scenes, m_config.queue, m_config.units_in_flight, m_config.redis_timeout);
+    m_backend = make_redis_backend(m_scenes, m_config.queue, m_config.units_in_flight, m_config.redis_timeout, m_config.farm);
   load_persisted();
   for (int i = 0; i < std::max(1, m_config.concurrency); ++i) m_workers.emplace_back([this] { worker_loop(); });
 }

@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "farm_security.h"
 #include "image.h"
 #include "job_spec.h"
 #include "job_store.h"
@@ -102,6 +103,7 @@ struct ManagerConfig {
   std::string queue = "embedded";  // or redis://host:port: render-workers do the rendering
   int units_in_flight = 4;         // Redis: sample passes queued ahead of the merges, per job
   double redis_timeout = 300;      // Redis: seconds a job waits for an unreachable Redis
+  FarmOptions farm;                // Redis: the password file, the farm key, --insecure-farm
   double checkpoint_interval = 30; // seconds between a running job's checkpoints (0: every pass)
   size_t keep_jobs = 0;            // finished jobs kept; past it the oldest are deleted (0: all)
   uint64_t max_data_bytes = 0;     // the data folder's size past which finished jobs are deleted (0: no cap)
@@ -169,6 +171,7 @@ class JobManager {
   const ManagerConfig& config() const { return m_config; }
   std::string backend_name() const;
   int live_workers() const;  // -1 for the embedded backend
+  json farm() const;         // null for the embedded backend
   SceneLibrary& scenes() { return m_scenes; }
   std::string job_dir(const std::string& id) const;
   std::string checkpoint_path(const std::string& id) const { return job_dir(id) + "/checkpoint.bin"; }

@@ -43,6 +43,12 @@ const char* kUsage =
     "  --units-in-flight N  Redis: passes queued ahead of the merges per job (default 4; about\n"
     "                    the number of workers)\n"
     "  --redis-timeout SEC  Redis: seconds a job waits for an unreachable Redis, then fails (default 300)\n"
+    "                    The URL may hold a user, a password and a database: redis://USER:PASS@HOST:PORT/DB\n"
+    "  --redis-password-file F  Redis: the password, read from a file (or PT_REDIS_PASSWORD), kept\n"
+    "                    out of the process list\n"
+    "  --farm-key-file F  Redis: sign pass requests and check the workers' signed results with this\n"
+    "                    shared key (HMAC-SHA256; the same file on every worker)\n"
+    "  --insecure-farm   Redis: allow an unsigned farm on a Redis that is not on loopback\n"
     "  --max-scene-mb M  the largest scene PUT /api/scenes/{name} takes, in MiB (default 64).\n"
     "                    Uploaded scenes are kept in DIR/scenes of --data\n"
     "  --checkpoint-interval SEC  seconds between a running job's checkpoints, which a restart, a\n"
@@ -158,6 +164,9 @@ int main(int argc, char** argv) {
     else if (a == "--queue") cfg.queue = value();
     else if (a == "--units-in-flight") { const char* v = value(); if (!parse_int(v, 1, 1024, &n)) bad(v); cfg.units_in_flight = int(n); }
     else if (a == "--redis-timeout") { const char* v = value(); if (!parse_seconds(v, &cfg.redis_timeout)) bad(v); }
+    else if (a == "--redis-password-file") cfg.farm.password_file = value();
+    else if (a == "--farm-key-file") cfg.farm.key_file = value();
+    else if (a == "--insecure-farm") cfg.farm.insecure = true;
     else if (a == "--checkpoint-interval") {
       const char* v = value();
       char* end;

@@ -5,11 +5,14 @@
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <random>
 #include <set>
+#include <tuple>
 
 #include "checkpoint.h"
+#include "farm_ledger.h"
 #include "scene_file.h"
 #include "job_store.h"
 #include "film_pass.h"
@@ -126,8 +129,9 @@ std::vector<std::string> parse_features(const std::string* text) {
 class WorkerPasses : public pt::PassSource {
  public:
   WorkerPasses(const Job& job, const std::string& scene_text, RedisClient& redis, JobSink& sink,
-               std::function<int()> live_workers, int in_flight)
-      : m_job(job), m_params(job.spec.params), m_scene_text(scene_text), m_redis(redis), m_sink(sink),
+               std::function<int()> live_workers, int in_flight, const FarmKey* key, FarmLedger& ledger)
+      : m_job(job), m_params(job.spec.params), m_scene_text(scene_text), m_redis(redis), m_sink(sink), m_key(key),
+        m_ledger(ledger),
         m_live_workers(std::move(live_workers)), m_in_flight(in_flight),
         m_w(m_params.cell_w > 0 ? m_params.cell_w : m_params.width),
         m_h(m_params.cell_w > 0 ? m_params.cell_h : m_params.height),
@@ -176,12 +180,16 @@ class WorkerPasses : public pt::PassSource {
   void issue(size_t unit);
   void publish();
   bool merge(const RedisReply& r);  // true when a pass was merged
+  // Why the result entry `body` must not be merged ("" when it may be); `pass` receives it decoded.
+  std::string check(const RedisReply& body, const std::string& worker, uint32_t& unit, pt::FilmPass& pass);
 
   const Job& m_job;
   const pt::RenderParams& m_params;
   const std::string& m_scene_text;
   RedisClient& m_redis;
   JobSink& m_sink;
+  const FarmKey* m_key;  // null: an unsigned farm
+  FarmLedger& m_ledger;
   std::function<int()> m_live_workers;
   int m_in_flight;
   int m_w, m_h;
@@ -190,6 +198,8 @@ class WorkerPasses : public pt::PassSource {
   pt::Film m_film;
   std::vector<pt::Tile> m_tiles;
   std::set<uint32_t> m_merged;
+  std::map<uint32_t, std::string> m_signatures;  // merged units' result signatures: a copy is a replay
+  std::map<uint32_t, std::string> m_masks;       // the converged-pixel mask each unmerged unit was sent
   std::string m_last_id = "0-0";
   uint64_t m_published = ~uint64_t(0);  // the connection the run was last published on (none yet)
   int m_workers = 1;
@@ -228,10 +238,15 @@ void WorkerPasses::restore(pt::BinaryReader& in) {
 }
 
 void WorkerPasses::issue(size_t unit) {
-  auto [first, count] = m_plan.range(unit);
-  m_redis.command({"XADD", rq::kWorkStream, "*", "job", m_job.id, "run", m_run, "unit", std::to_string(unit), "first",
-                   std::to_string(first), "count", std::to_string(count), "mask",
-                   m_params.adaptive ? pt::pack_mask(m_film.done_mask()) : std::string()});
+  rq::WorkItem w;
+  w.job = m_job.id, w.run = m_run, w.unit = uint32_t(unit);
+  std::tie(w.first, w.count) = m_plan.range(unit);
+  w.mask = m_params.adaptive ? pt::pack_mask(m_film.done_mask()) : std::string();
+  std::vector<std::string> args{"XADD", rq::kWorkStream, "*", "job", w.job, "run", w.run, "unit", std::to_string(unit),
+                                "first", std::to_string(w.first), "count", std::to_string(w.count), "mask", w.mask};
+  if (m_key) args.insert(args.end(), {"sig", rq::request_signature(*m_key, w)});
+  m_redis.command(args);
+  m_masks[w.unit] = std::move(w.mask);
 }
 
 // Puts what workers need in Redis: the group, the scene's bytes (once per content: repeated jobs on
@@ -246,7 +261,8 @@ void WorkerPasses::publish() {
     rq::ensure_group(m_redis);
     m_redis.command({"SET", rq::scene_key(m_scene_hash), m_scene_text, "EX", ttl, "NX"});
     m_redis.command({"EXPIRE", rq::scene_key(m_scene_hash), ttl});
-    bool fresh = m_redis.command({"HSET", m_job_key, "spec", m_spec_json, "scene", m_scene_hash}).integer_value > 0;
+    const std::string sig = m_key ? rq::run_signature(*m_key, m_job.id, m_run, m_spec_json, m_scene_hash) : "";
+    bool fresh = m_redis.command({"HSET", m_job_key, "spec", m_spec_json, "scene", m_scene_hash, "sig", sig}).integer_value > 0;
     m_redis.command({"EXPIRE", m_job_key, ttl});
     if (fresh && m_plan.issued() > m_merged.size()) {
       std::fprintf(stderr, "render-server: job %s: the run's keys were gone from Redis; issuing its %zu unmerged passes again\n",
@@ -258,6 +274,51 @@ void WorkerPasses::publish() {
   } while (m_redis.connections() != m_published);
 }
 
+// check()'s answer for a second rendering of a merged pass: not merged, and not a refusal either.
+const std::string kRenderedTwice = "rendered twice";
+
+std::string WorkerPasses::check(const RedisReply& body, const std::string& worker, uint32_t& u, pt::FilmPass& pass) {
+  const std::string *job = body.field("job"), *run = body.field("run"), *unit = body.field("unit"),
+                    *bytes = body.field("pass"), *error = body.field("error"), *sig = body.field("sig");
+  if ((job && *job != m_job.id) || (run && *run != m_run))
+    return "a result for another job or run (job '" + valid_utf8(job ? *job : m_job.id, 64) + "')";
+  if (!unit || (!bytes && !error)) return "a malformed entry (no unit, or neither pass nor error)";
+  if (m_key) {
+    if (!sig) return "unsigned";
+    const std::string features = body.field("features") ? *body.field("features") : "";
+    const std::string attempt = body.field("attempt") ? *body.field("attempt") : "";
+    const bool good = bytes ? m_key->verify(*sig, {"pt-result", m_job.id, m_run, *unit, worker, attempt, *bytes, features})
+                            : m_key->verify(*sig, {"pt-error", m_job.id, m_run, *unit, worker, *error});
+    if (!good) return "bad signature (not made with the farm key, or made for another job, run, pass or worker)";
+  }
+  if (error) return "";  // signed (or an unsigned farm's): the job fails with its text
+  if (!rq::parse_u32(unit, u) || u >= m_plan.issued()) return "pass '" + valid_utf8(*unit, 20) + "' was never issued";
+  if (m_merged.count(u)) {
+    // A second rendering or sending of a pass (its first worker looked dead, a connection broke
+    // while sending) is normal and differs in its signature; the same signed bytes again are a copy.
+    auto it = m_signatures.find(u);
+    return sig && it != m_signatures.end() && it->second == *sig ? "replayed (pass " + std::to_string(u) + " was already merged)"
+                                                                 : kRenderedTwice;
+  }
+  try {
+    pass = pt::FilmPass::decode(*bytes, m_w, m_h);
+  } catch (const std::exception& e) {
+    return std::string("a bad pass: ") + e.what();
+  }
+  const auto [first, count] = m_plan.range(u);
+  if (pass.first != first || pass.count != count)
+    return "samples [" + std::to_string(pass.first) + ", " + std::to_string(uint64_t(pass.first) + pass.count) + ") where pass " +
+           std::to_string(u) + " asked for [" + std::to_string(first) + ", " + std::to_string(first + count) + ")";
+  auto mask = m_masks.find(u);
+  if (mask != m_masks.end() && !mask->second.empty()) {
+    const std::vector<uint8_t> skip = pt::unpack_mask(mask->second, pass.samples.size());
+    for (size_t i = 0; i < skip.size(); ++i)
+      if (skip[i] && pass.samples[i] != 0)
+        return "samples in pixel " + std::to_string(i) + ", which pass " + std::to_string(u) + " was told to skip";
+  }
+  return "";
+}
+
 bool WorkerPasses::merge(const RedisReply& r) {
   // Everything read from Redis is checked: [[stream, [[id, [field, value, ...]], ...]]].
   if (r.type != RedisReply::array || r.elements.empty() || r.elements[0].elements.size() < 2) return false;
@@ -266,14 +327,17 @@ bool WorkerPasses::merge(const RedisReply& r) {
     if (e.elements.size() != 2 || e.elements[0].type != RedisReply::string) continue;
     m_last_id = e.elements[0].str;
     const RedisReply& body = e.elements[1];
-    if (const std::string* err = body.field("error")) throw std::runtime_error(valid_utf8(*err, 2000));
-    const std::string* bytes = body.field("pass");
+    const std::string worker = valid_utf8(body.field("worker") ? *body.field("worker") : "(unnamed)", 64);
     uint32_t u = 0;
-    if (!rq::parse_u32(body.field("unit"), u) || !bytes) continue;
-    if (u >= m_plan.issued() || m_merged.count(u)) continue;  // a pass rendered twice (its first worker looked dead)
-    pt::FilmPass pass = pt::FilmPass::decode(*bytes, m_w, m_h);
-    m_pass_bytes += bytes->size();
-    if (pass.first != m_plan.range(u).first || pass.count != m_plan.range(u).second) continue;
+    pt::FilmPass pass;
+    const std::string refusal = check(body, worker, u, pass);
+    if (refusal == kRenderedTwice) continue;  // its first worker looked dead: the first copy counts
+    if (!refusal.empty()) {
+      m_ledger.rejected(worker, m_job.id, refusal);
+      continue;
+    }
+    if (const std::string* err = body.field("error")) throw std::runtime_error(valid_utf8(*err, 2000));
+    m_pass_bytes += body.field("pass")->size();
     uint64_t pass_samples = 0;
     for (uint32_t n : pass.samples) pass_samples += n;
     m_plan.observe(pass_samples, pass.seconds);
@@ -283,6 +347,9 @@ bool WorkerPasses::merge(const RedisReply& r) {
     }
     m_film.merge(pass);
     m_merged.insert(u);
+    m_masks.erase(u);
+    if (const std::string* sig = body.field("sig")) m_signatures[u] = *sig;
+    m_ledger.merged(worker);
     m_samples += pass_samples;
     m_rays += pass.rays;
     m_nonfinite += pass.nonfinite;
@@ -338,8 +405,10 @@ void WorkerPasses::finish(pt::StopReason why) {
 
 class RedisBackend : public RenderBackend {
  public:
-  RedisBackend(SceneLibrary& scenes, const std::string& url, int in_flight, double redis_timeout)
-      : m_scenes(scenes), m_address(RedisAddress::parse(url)), m_in_flight(std::max(1, in_flight)),
+  RedisBackend(SceneLibrary& scenes, const std::string& url, int in_flight, double redis_timeout, const FarmOptions& farm)
+      : m_scenes(scenes), m_address(farm_address(url, farm, "render-server")),
+        m_key(farm_key(m_address, farm, "render-server")), m_loopback(resolves_to_loopback(m_address.host)),
+        m_in_flight(std::max(1, in_flight)),
         m_redis_timeout(redis_timeout) {
     RedisClient redis(m_address);
     rq::ensure_group(redis);
@@ -351,11 +420,23 @@ class RedisBackend : public RenderBackend {
     std::lock_guard<std::mutex> lock(m_health_mutex);
     try {
       if (!m_health) m_health = std::make_unique<RedisClient>(m_address, 1.0);
-      return rq::count_workers(*m_health);
+      auto live = rq::live_workers(*m_health);
+      m_ledger.heard(live);
+      return int(live.size());
     } catch (const std::exception&) {
       m_health.reset();
+      m_ledger.heard({});
       return 0;  // Redis unreachable: no worker can take work
     }
+  }
+
+  nlohmann::json farm() override {
+    nlohmann::json f = m_ledger.to_json();
+    f["queue"] = m_address.url();
+    f["authenticated"] = !m_address.password.empty();
+    f["signed"] = m_key != nullptr;
+    f["insecure"] = !m_key && !m_loopback;
+    return f;
   }
 
   RenderResult render(const Job& job, JobSink& sink, const std::atomic<bool>& stop, const CheckpointPlan& plan) override {
@@ -367,7 +448,7 @@ class RedisBackend : public RenderBackend {
     // An unreachable Redis (a restart) is waited for, up to --redis-timeout; a cancel ends the wait.
     RedisClient redis(m_address, 5.0, false);
     redis.set_patience(m_redis_timeout, &stop, "render-server: job " + job.id);
-    WorkerPasses passes(job, scene_text, redis, sink, [this] { return live_workers(); }, m_in_flight);
+    WorkerPasses passes(job, scene_text, redis, sink, [this] { return live_workers(); }, m_in_flight, m_key.get(), m_ledger);
     RenderResult result = render_job(passes, job, sink, stop, plan, pt::render_fingerprint(scene_text, spec.params),
                                      [&](bool resumed) {
                                        if (!resumed) return;  // the first merged pass starts the sink
@@ -385,6 +466,9 @@ class RedisBackend : public RenderBackend {
  private:
   SceneLibrary& m_scenes;
   RedisAddress m_address;
+  std::shared_ptr<const FarmKey> m_key;  // null: an unsigned farm
+  bool m_loopback;  // Redis is on this machine: an unsigned farm is not exposed
+  FarmLedger m_ledger;
   int m_in_flight;
   double m_redis_timeout;  // seconds a job waits for an unreachable Redis (--redis-timeout)
   std::mutex m_health_mutex;
@@ -394,8 +478,8 @@ class RedisBackend : public RenderBackend {
 }  // namespace
 
 std::unique_ptr<RenderBackend> make_redis_backend(SceneLibrary& scenes, const std::string& url, int units_in_flight,
-                                                  double redis_timeout) {
-  return std::make_unique<RedisBackend>(scenes, url, units_in_flight, redis_timeout);
+                                                  double redis_timeout, const FarmOptions& farm) {
+  return std::make_unique<RedisBackend>(scenes, url, units_in_flight, redis_timeout, farm);
 }
 
 }  // namespace srv

@@ -19,6 +19,16 @@ namespace srv {
 struct RedisError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// Redis refused this client: a wrong or missing password (WRONGPASS, NOAUTH) or an ACL user
+// without a permission it needs (NOPERM). Retrying cannot help, so it is never retried.
+struct RedisAuthError : RedisError {
+  using RedisError::RedisError;
+};
+// The connection broke after a command that must not be sent twice was written: Redis may or may
+// not have run it. The caller decides (render-worker sends its result again as a new attempt).
+struct RedisMaybeSent : RedisError {
+  using RedisError::RedisError;
+};
 // Redis could not be reached (no connection, a broken one), and stayed so for the client's patience
 // or until its abort flag was set.
 struct RedisUnreachable : RedisError {
@@ -41,12 +51,16 @@ struct RedisReply {
   const std::string* field(const std::string& name) const;
 };
 
-// "redis://host:port" (the port defaults to 6379); throws std::invalid_argument naming the URL.
+// "redis://[user[:password]@]host[:port][/db]" (the port defaults to 6379, the database to 0; user and
+// password may be percent-encoded); throws std::invalid_argument naming the URL, without its password.
 struct RedisAddress {
   std::string host = "127.0.0.1";
   int port = 6379;
+  int db = 0;
+  std::string user, password;  // AUTH [user] password on every connection when a password is set
   static RedisAddress parse(const std::string& url);
-  std::string url() const { return "redis://" + host + ":" + std::to_string(port); }
+  // The URL without the password: what logs, errors and /api/health show.
+  std::string url() const;
 };
 
 class RedisClient {
@@ -61,8 +75,9 @@ class RedisClient {
   // Runs one command. A Redis error reply throws RedisError with its text, except where
   // `allow_error` is set (then it comes back as a reply of type error). A broken connection is
   // re-opened and the command sent again (see set_patience); commands here are idempotent or their
-  // effects are de-duplicated by the caller.
-  RedisReply command(const std::vector<std::string>& args, bool allow_error = false);
+  // effects are de-duplicated by the caller. With `resend` false, a connection that breaks after
+  // the command was written throws RedisMaybeSent instead (one not yet written is still retried).
+  RedisReply command(const std::vector<std::string>& args, bool allow_error = false, bool resend = true);
   // How long a command keeps retrying an unreachable Redis (back-off 0.1 s doubling to 2 s) before
   // it throws RedisUnreachable; 0 (the default): one immediate reconnect only. A set `abort` ends
   // the wait at once. `who` prefixes the log lines of an outage ("" logs nothing).

@@ -21,16 +21,30 @@ int delivery_count(RedisClient& redis, const std::string& entry_id) {
   return int(std::min<long long>(std::max<long long>(e.elements[3].integer_value, 0), 1 << 30));
 }
 
-int count_workers(RedisClient& redis) {
-  int n = 0;
+std::vector<std::pair<std::string, int>> live_workers(RedisClient& redis, size_t limit) {
+  std::vector<std::string> keys;
   std::string cursor = "0";
   do {
     RedisReply r = redis.command({"SCAN", cursor, "MATCH", "pt:worker:*", "COUNT", "1000"});
-    if (r.elements.size() != 2) break;
+    if (r.elements.size() != 2 || r.elements[0].type != RedisReply::string) break;
     cursor = r.elements[0].str;
-    n += int(r.elements[1].elements.size());
-  } while (cursor != "0");
-  return n;
+    for (const RedisReply& k : r.elements[1].elements)
+      if (k.type == RedisReply::string && keys.size() < limit) keys.push_back(k.str);
+  } while (cursor != "0" && keys.size() < limit);
+  std::vector<std::pair<std::string, int>> out;
+  if (keys.empty()) return out;
+  std::vector<std::string> mget{"MGET"};
+  mget.insert(mget.end(), keys.begin(), keys.end());
+  RedisReply values = redis.command(mget);
+  const size_t prefix = worker_key("").size();
+  for (size_t i = 0; i < keys.size(); ++i) {
+    uint32_t threads = 0;
+    const bool known = i < values.elements.size() && values.elements[i].type == RedisReply::string &&
+                       parse_u32(&values.elements[i].str, threads);
+    if (i < values.elements.size() && values.elements[i].is_nil()) continue;  // expired since the SCAN
+    out.emplace_back(valid_utf8(std::string_view(keys[i]).substr(prefix), 64), known ? int(std::min(threads, 100000u)) : 0);
+  }
+  return out;
 }
 
 bool parse_u32(const std::string* s, uint32_t& out) {
@@ -57,16 +71,9 @@ bool parse_work_item(const RedisReply& entry, WorkItem& out) {
   out.job = *job;
   out.run = *run;
   if (mask) out.mask = *mask;
+  if (const std::string* sig = body.field("sig")) out.sig = *sig;
   return parse_u32(body.field("unit"), out.unit) && parse_u32(body.field("first"), out.first) &&
          parse_u32(body.field("count"), out.count) && out.count > 0;
-}
-
-std::string content_hash(const std::string& bytes) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char ch : bytes) h = (h ^ ch) * 1099511628211ull;
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
-  return buf;
 }
 
 }  // namespace srv::rq

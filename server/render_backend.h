@@ -10,6 +10,9 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "farm_security.h"
 #include "film_denoise.h"
 #include "session.h"
 
@@ -78,13 +81,17 @@ class RenderBackend {
   virtual std::string name() const = 0;
   // Render workers seen in the last few seconds; -1 where the backend has none (embedded).
   virtual int live_workers() { return -1; }
+  // The farm's workers, refused results and security (FarmLedger, /api/health); null where there is none.
+  virtual nlohmann::json farm() { return nullptr; }
 };
 
 // The embedded backend: renders in this process with `threads` threads.
 std::unique_ptr<RenderBackend> make_embedded_backend(SceneLibrary& scenes, int threads);
 // The Redis backend: `url` is redis://host:port. Throws when Redis cannot be reached at start; a
 // job waits out an unreachable Redis (a restart) for up to `redis_timeout` seconds, then fails.
+// `farm`: the password file, the farm key and --insecure-farm (farm_security.h); a non-loopback
+// Redis without a key or --insecure-farm, or Redis refusing the credentials, throws.
 std::unique_ptr<RenderBackend> make_redis_backend(SceneLibrary& scenes, const std::string& url, int units_in_flight,
-                                                  double redis_timeout);
+                                                  double redis_timeout, const FarmOptions& farm);
 
 }  // namespace srv

@@ -32,7 +32,7 @@ std::shared_ptr<Job> job_or_404(JobManager& jobs, const Request& req) {
 
 // ---- the service ----
 
-void get_health(JobManager& jobs, const ApiOptions&, const Request&, Response& res) {
+void get_health(JobManager& jobs, const ApiOptions& options, const Request& req, Response& res) {
   size_t queued = 0, running = 0, paused = 0;
   for (auto& j : jobs.list()) {
     std::lock_guard<std::mutex> lock(j->mutex);
@@ -47,7 +47,13 @@ void get_health(JobManager& jobs, const ApiOptions&, const Request&, Response& r
   StreamStats st = stream_stats();
   health["stream"] = {{"watchers", st.watchers}, {"png_encodes", st.png_encodes}, {"tile_events", st.tile_events}};
   int workers = jobs.live_workers();
-  if (workers >= 0) health["workers"] = workers;
+  if (workers >= 0) health["workers"] = workers;  // also refreshes the farm's live workers
+  if (json farm = jobs.farm(); !farm.is_null()) {
+    // The probe answers without the token; who works for the farm, on which Redis, is for those with it.
+    if (!authorized(req, options.token))
+      for (const char* k : {"queue", "workers", "rejections"}) farm.erase(k);
+    health["farm"] = std::move(farm);
+  }
   const pt::Denoiser& denoiser = pt::Denoiser::shared();  // a job's denoise field needs it
   health["denoiser"] = {{"available", denoiser.available()}, {"description", denoiser.summary()}};
   send_json(res, 200, health);

@@ -31,7 +31,13 @@ using namespace srv;
 const char* kUsage =
     "Usage: render-worker [options]\n"
     "Renders sample passes that render-server --queue redis://HOST:PORT hands out.\n"
-    "  --queue URL          the Redis server (default redis://127.0.0.1:6379)\n"
+    "  --queue URL          the Redis server (default redis://127.0.0.1:6379); it may hold a user,\n"
+    "                       a password and a database: redis://USER:PASS@HOST:PORT/DB\n"
+    "  --redis-password-file F  the Redis password, read from a file (or PT_REDIS_PASSWORD), kept\n"
+    "                       out of the process list\n"
+    "  --farm-key-file F    the farm's shared key: take only passes the server signed with it, and\n"
+    "                       sign the results (the same file as render-server's)\n"
+    "  --insecure-farm      allow an unsigned farm on a Redis that is not on loopback\n"
     "  -t, --threads N      render threads (default: all cores)\n"
     "  --name NAME          consumer name in the group (default: host-pid)\n"
     "  --claim-timeout SEC  take over passes a worker left unacknowledged this long (default 10)\n"
@@ -50,6 +56,12 @@ struct Options {
   double claim_timeout = 10;
   double redis_timeout = 300;
   bool quiet = false;
+  FarmOptions farm;
+};
+
+// This worker has no farm key but the server signs its passes: it cannot take part (exit 2).
+struct NeedsFarmKey : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 // A run being worked on: its spec and its view of the scene. A worker keeps the few most recent
@@ -67,11 +79,15 @@ constexpr size_t kRunsKept = 4, kBasesKept = 2;
 class Worker {
  public:
   explicit Worker(Options o)
-      : m_opt(std::move(o)), m_address(RedisAddress::parse(m_opt.queue)), m_redis(m_address, 5.0, false) {
+      : m_opt(std::move(o)), m_address(farm_address(m_opt.queue, m_opt.farm, "render-worker")),
+        m_key(farm_key(m_address, m_opt.farm, "render-worker")), m_redis(m_address, 5.0, false) {
     m_redis.set_patience(m_opt.redis_timeout, &g_stop, "render-worker " + m_opt.name);
     rq::ensure_group(m_redis);
     m_grouped = m_redis.connections();
   }
+
+  std::string address() const { return m_address.url(); }
+  bool signed_farm() const { return m_key != nullptr; }
 
   void run() {
     while (!g_stop) {
@@ -135,10 +151,34 @@ class Worker {
     return true;
   }
 
+  // A malformed pass request, or on a signed farm one not signed with the key, is dropped (and
+  // logged): only the server can issue work. A keyless worker on a signed farm stops.
   bool parse_or_drop(const RedisReply& entry, rq::WorkItem& item) {
-    if (rq::parse_work_item(entry, item)) return true;
+    if (rq::parse_work_item(entry, item)) {
+      if (!m_key && !item.sig.empty()) {
+        release(item);
+        throw NeedsFarmKey("pass " + std::to_string(item.unit) + " of job " + valid_utf8(item.job, 64) +
+                           " is signed: this farm signs its passes, so start the worker with the server's "
+                           "--farm-key-file");
+      }
+      if (!m_key || same_signature(rq::request_signature(*m_key, item), item.sig)) return true;
+      ++m_refused;
+      std::fprintf(stderr, "render-worker %s: refused pass %u of job %s: %s (%llu refused so far)\n",
+                   m_opt.name.c_str(), item.unit, valid_utf8(item.job, 64).c_str(),
+                   item.sig.empty() ? "unsigned (not issued by the server)"
+                                    : "bad signature (not issued by a server with this farm key)",
+                   (unsigned long long)m_refused);
+    }
     if (entry.type == RedisReply::array && !entry.elements.empty()) acknowledge(entry.elements[0].str);
     return false;
+  }
+
+  // Gives a pass back for the next XAUTOCLAIM of any worker to take at once (JUSTID: this claim
+  // is not counted as a delivery).
+  void release(const rq::WorkItem& item) {
+    m_redis.command({"XCLAIM", rq::kWorkStream, rq::kGroup, m_opt.name, "0", item.entry_id, "IDLE",
+                     std::to_string(int64_t(3600) * 24 * 365 * 1000), "JUSTID"},
+                    true);
   }
 
   // Error replies are ignored: after a restart of Redis the entry (or the group) may be gone.
@@ -155,11 +195,7 @@ class Worker {
                  item.job.c_str(), item.unit, deliveries, rq::kMaxDeliveries, why.c_str());
     if (deliveries == 0) return;  // no longer pending (Redis restarted): nothing to release
     if (deliveries >= rq::kMaxDeliveries) return dead_letter(item, why, deliveries);
-    // An idle time past every --claim-timeout makes the next XAUTOCLAIM take it (JUSTID: this
-    // claim is not counted as a delivery).
-    m_redis.command({"XCLAIM", rq::kWorkStream, rq::kGroup, m_opt.name, "0", item.entry_id, "IDLE",
-                     std::to_string(int64_t(3600) * 24 * 365 * 1000), "JUSTID"},
-                    true);
+    release(item);
   }
 
   void dead_letter(const rq::WorkItem& item, const std::string& why, int tries) {
@@ -176,11 +212,13 @@ class Worker {
                    valid_utf8(r.str, 1000).c_str());
     // The server fails the job with this; the results key may itself be damaged, which the
     // server's own read of it then reports.
-    const std::string results = rq::results_key(item.job, item.run);
-    m_redis.command({"XADD", results, "*", "unit", std::to_string(item.unit), "worker", m_opt.name, "error",
-                     "pass " + std::to_string(item.unit) + " (samples " + range + ") failed " + std::to_string(tries) +
-                         " times and was set aside in " + rq::kDeadStream + ": " + why},
-                    true);
+    const std::string results = rq::results_key(item.job, item.run), unit = std::to_string(item.unit);
+    const std::string error = "pass " + unit + " (samples " + range + ") failed " + std::to_string(tries) +
+                              " times and was set aside in " + rq::kDeadStream + ": " + why;
+    std::vector<std::string> args{"XADD", results, "*", "job", item.job, "run", item.run, "unit", unit,
+                                  "worker", m_opt.name, "error", error};
+    if (m_key) args.insert(args.end(), {"sig", rq::error_signature(*m_key, item.job, item.run, unit, m_opt.name, error)});
+    m_redis.command(args, true);
     m_redis.command({"EXPIRE", results, std::to_string(rq::kKeyTtlSeconds)}, true);
     acknowledge(item.entry_id);
     std::fprintf(stderr, "render-worker %s: job %s pass %u set aside in %s after %d tries\n", m_opt.name.c_str(),
@@ -209,18 +247,41 @@ class Worker {
       }
       std::string features;
       for (const std::string& f : m_runs.front()->features) features += (features.empty() ? "" : ",") + f;
-      m_redis.command({"XADD", results, "*", "unit", std::to_string(item.unit), "worker", m_opt.name, "pass",
-                       pass.encode(), "features", features});
+      send_result(item, pass.encode(), features);
       m_redis.command({"EXPIRE", results, std::to_string(rq::kKeyTtlSeconds)});
       acknowledge(item.entry_id);
       log("job %s pass %u: samples [%u, %u) in %.2f s", item.job.c_str(), item.unit, item.first,
           item.first + item.count, pass.seconds);
     } catch (const RedisUnreachable&) {
       throw;  // Redis stayed away past --redis-timeout, or a signal: the pass stays pending
+    } catch (const RedisAuthError&) {
+      throw;  // the credentials or the ACL rules are wrong: no pass can succeed, so the worker stops
     } catch (const std::exception& e) {
       // The run's keys, spec or scene are unusable (a damaged key answers WRONGTYPE): try again,
       // at most kMaxDeliveries times in all.
       fail(item, e.what());
+    }
+  }
+
+  // Adds the result to the run's results stream. The send is never repeated blindly: when the
+  // connection breaks during it, Redis may have the entry already, so the next send is a new
+  // attempt (a new signature) that the server merges only if the first never arrived.
+  void send_result(const rq::WorkItem& item, const std::string& bytes, const std::string& features) {
+    const std::string results = rq::results_key(item.job, item.run), unit = std::to_string(item.unit);
+    for (int attempt = 1;; ++attempt) {
+      const std::string n = std::to_string(attempt);
+      std::vector<std::string> args{"XADD", results, "*", "job", item.job, "run", item.run, "unit", unit, "worker",
+                                    m_opt.name, "attempt", n, "pass", bytes, "features", features};
+      if (m_key)
+        args.insert(args.end(), {"sig", rq::result_signature(*m_key, item.job, item.run, unit, m_opt.name, n, bytes, features)});
+      try {
+        m_redis.command(args, false, false);
+        return;
+      } catch (const RedisMaybeSent& e) {
+        if (attempt >= 8) throw;
+        log("%s; sending pass %u again once Redis answers", e.what(), item.unit);
+        m_redis.command({"PING"});  // waits out the outage (up to --redis-timeout)
+      }
     }
   }
 
@@ -233,10 +294,16 @@ class Worker {
         m_runs.splice(m_runs.begin(), m_runs, it);  // most recent first
         return m_redis.command({"EXISTS", key}).integer_value == 1;
       }
-    RedisReply r = m_redis.command({"HMGET", key, "spec", "scene"});
-    if (r.elements.size() != 2 || r.elements[0].is_nil() || r.elements[1].is_nil()) return false;
+    RedisReply r = m_redis.command({"HMGET", key, "spec", "scene", "sig"});
+    if (r.elements.size() != 3 || r.elements[0].is_nil() || r.elements[1].is_nil()) return false;
     if (r.elements[0].type != RedisReply::string || r.elements[1].type != RedisReply::string)
       throw std::runtime_error(key + ": unexpected reply");
+    // The spec and the scene's content hash are what the worker renders: on a signed farm only
+    // the server's.
+    if (m_key && (r.elements[2].type != RedisReply::string ||
+                  !same_signature(rq::run_signature(*m_key, item.job, item.run, r.elements[0].str, r.elements[1].str),
+                                  r.elements[2].str)))
+      throw std::runtime_error(valid_utf8(key, 200) + ": the run's spec and scene are not signed with the farm key");
     auto run = std::make_unique<PreparedRun>();
     run->key = key;
     run->spec = parse_job_spec(json::parse(r.elements[0].str));
@@ -259,6 +326,8 @@ class Worker {
     RedisReply text = m_redis.command({"GET", rq::scene_key(hash)});
     if (text.type != RedisReply::string)
       throw std::runtime_error("the scene of job '" + name + "' is no longer in Redis");
+    if (rq::content_hash(text.str) != hash)  // the run names its scene by content; anything else is not it
+      throw std::runtime_error("the scene of job '" + name + "' in Redis does not match its content hash");
     auto t0 = std::chrono::steady_clock::now();
     auto base = std::make_shared<const pt::SceneBase>(pt::make_scene_base(pt::parse_scene(text.str, pt::scene_file_name(name, text.str))));
     log("scene '%s' built in %.3f s", name.c_str(),
@@ -334,7 +403,9 @@ class Worker {
 
   Options m_opt;
   RedisAddress m_address;
+  std::shared_ptr<const FarmKey> m_key;  // null: an unsigned farm
   RedisClient m_redis;
+  uint64_t m_refused = 0;  // pass requests refused (unsigned or badly signed)
   uint64_t m_grouped = 0;  // the connection on which the group was last ensured
   std::list<std::unique_ptr<PreparedRun>> m_runs;  // most recent first
   std::list<std::pair<std::string, std::shared_ptr<const pt::SceneBase>>> m_bases;
@@ -368,6 +439,12 @@ bool parse_options(int argc, char** argv, Options& o) {
       if (!(o.redis_timeout >= 0.1 && o.redis_timeout <= 3600)) throw std::invalid_argument("--redis-timeout must be 0.1-3600 s");
     } else if (a == "--quiet") {
       o.quiet = true;
+    } else if (a == "--redis-password-file") {
+      o.farm.password_file = value();
+    } else if (a == "--farm-key-file") {
+      o.farm.key_file = value();
+    } else if (a == "--insecure-farm") {
+      o.farm.insecure = true;
     } else {
       throw std::invalid_argument("unknown option '" + a + "' (see --help)");
     }
@@ -400,13 +477,19 @@ int main(int argc, char** argv) {
   for (double wait = 0.1; !g_stop; wait = std::min(wait * 2, 2.0)) {
     try {
       Worker worker(opt);
-      std::fprintf(stderr, "render-worker %s: taking passes from %s with %d threads\n", opt.name.c_str(),
-                   opt.queue.c_str(), opt.threads);
+      std::fprintf(stderr, "render-worker %s: taking passes from %s with %d threads%s\n", opt.name.c_str(),
+                   worker.address().c_str(), opt.threads, worker.signed_farm() ? " (signed farm)" : "");
       wait = 0.1;
       worker.run();
     } catch (const std::invalid_argument& e) {
       std::fprintf(stderr, "render-worker: %s\n", e.what());
       return 2;
+    } catch (const NeedsFarmKey& e) {
+      std::fprintf(stderr, "render-worker %s: %s\n", opt.name.c_str(), e.what());
+      return 2;
+    } catch (const RedisAuthError& e) {
+      std::fprintf(stderr, "render-worker: %s\n", e.what());
+      return 1;
     } catch (const RedisUnreachable& e) {
       if (g_stop) break;
       std::fprintf(stderr, "render-worker: %s; giving up\n", e.what());

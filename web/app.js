@@ -2,8 +2,9 @@
 // click-to-focus, and the wiring. No framework, no build step: common.js (state, API), feed.js (a
 // job's event stream), chart.js, sweep.js, jobs.js (the job list), viewer_tools.js (exposure,
 // mappings, zoom, readout), compare.js, denoise.js (the denoise control and the raw / denoised
-// switch), upload.js, form.js (the form) and camera.js (moving the camera on the image) load
-// before this file (index.html), as plain scripts sharing their names.
+// switch), upload.js, form.js (the form), camera.js (moving the camera on the image) and farm.js
+// (the Redis render farm's panel) load before this file (index.html), as plain scripts sharing
+// their names.
 'use strict';
 
 // ---------- the main viewer ----------
@@ -278,6 +279,7 @@ function init() {
   initCamera();
   initCompare();
   initDenoise();
+  initFarm();
   let resizeTimer = null;
   window.addEventListener('resize', () => {
     clearTimeout(resizeTimer);
@@ -303,6 +305,7 @@ async function start() {
     await new Promise((r) => setTimeout(r, 1000));
   }
   checkDenoiser();
+  pollFarm();
   await refreshJobs();
   const m = location.hash.match(/job=([0-9a-f]+)/);
   if (m) viewer.show(m[1]);

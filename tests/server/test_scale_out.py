@@ -31,22 +31,28 @@ def free_port():
 
 
 class Redis:
-    """A redis-server without persistence on a free loopback port, or on `port` (a restart)."""
+    """A redis-server without persistence on a free loopback port, or on `port` (a restart).
+    `args`: more redis-server options (--requirepass ...); `password`: what redis-cli logs in with;
+    `bind`: the address it listens on (and redis-cli connects to)."""
 
-    def __init__(self, root, port=None):
+    def __init__(self, root, port=None, args=(), password=None, bind="127.0.0.1"):
         assert shutil.which("redis-server"), "redis-server is missing: run scripts/install-deps.sh"
         self.port = port or free_port()
-        self.proc = subprocess.Popen(["redis-server", "--port", str(self.port), "--bind", "127.0.0.1", "--save", "",
-                                      "--appendonly", "no", "--dir", str(root)],
+        self.bind = bind
+        self.password = password
+        self.proc = subprocess.Popen(["redis-server", "--port", str(self.port), "--bind", bind, "--save", "",
+                                      "--appendonly", "no", "--dir", str(root), *args],
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         deadline = time.monotonic() + 10
         while self.cli("PING") != "PONG":
             assert time.monotonic() < deadline and self.proc.poll() is None, "redis-server did not start"
             time.sleep(0.05)
-        self.url = f"redis://127.0.0.1:{self.port}"
+        self.url = f"redis://{bind}:{self.port}"
 
     def cli(self, *args):
-        r = subprocess.run(["redis-cli", "-p", str(self.port), *args], capture_output=True, text=True, timeout=10)
+        env = dict(os.environ, REDISCLI_AUTH=self.password) if self.password else None
+        r = subprocess.run(["redis-cli", "-h", self.bind, "-p", str(self.port), *args], capture_output=True, text=True,
+                           timeout=10, env=env)
         return r.stdout.strip()
 
     def pending_by_worker(self):
@@ -62,12 +68,13 @@ class Redis:
 
 
 class Worker:
-    def __init__(self, root, redis_url, name, args=()):
+    def __init__(self, root, redis_url, name, args=(), env=None, prefix=()):
         self.name = name
         self.log_path = Path(root) / f"{name}.log"
         self.log = open(self.log_path, "wb")
-        self.proc = subprocess.Popen([str(RENDER_WORKER), "--queue", redis_url, "-t", "1", "--name", name,
-                                      "--claim-timeout", "1", *args], stdout=self.log, stderr=self.log)
+        self.proc = subprocess.Popen([*prefix, str(RENDER_WORKER), "--queue", redis_url, "-t", "1", "--name", name,
+                                      "--claim-timeout", "1", *args], stdout=self.log, stderr=self.log,
+                                     env=dict(os.environ, **env) if env else None)
 
     def text(self):
         return self.log_path.read_text(errors="replace")
