@@ -39,11 +39,13 @@ void FarmLedger::merged(const std::string& worker) {
 }
 
 void FarmLedger::rejected(const std::string& worker, const std::string& job, const std::string& reason) {
-  std::fprintf(stderr, "render-server: job %s: refused a result from worker '%s': %s\n", job.c_str(), worker.c_str(),
-               reason.c_str());
   std::lock_guard<std::mutex> lock(m_mutex);
   ++entry(worker).rejected;
   ++m_rejected;
+  // Whoever floods the results stream must not flood the log too: the first kLogged, then every kLogged-th.
+  if (m_rejected <= kLogged || m_rejected % kLogged == 0)
+    std::fprintf(stderr, "render-server: job %s: refused a result from worker '%s': %s%s\n", job.c_str(), worker.c_str(),
+                 reason.c_str(), m_rejected < kLogged ? "" : (" (" + std::to_string(m_rejected) + " refused so far)").c_str());
   m_rejections.push_front({worker, job, reason, clock::now()});
   if (m_rejections.size() > kRejectionsKept) m_rejections.pop_back();
 }

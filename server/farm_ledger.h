@@ -29,6 +29,7 @@ class FarmLedger {
   nlohmann::json to_json() const;
 
   static constexpr size_t kWorkersKept = 256, kRejectionsKept = 20;
+  static constexpr uint64_t kLogged = 100;  // refusals logged one by one; then every 100th
 
  private:
   using clock = std::chrono::steady_clock;

@@ -181,6 +181,7 @@ class WorkerPasses : public pt::PassSource {
   void publish();
   bool merge(const RedisReply& r);  // true when a pass was merged
   // Why the result entry `body` must not be merged ("" when it may be); `pass` receives it decoded.
+  // `worker` is the name it claims, cut and made valid UTF-8 for logs.
   std::string check(const RedisReply& body, const std::string& worker, uint32_t& unit, pt::FilmPass& pass);
 
   const Job& m_job;
@@ -279,7 +280,8 @@ const std::string kRenderedTwice = "rendered twice";
 
 std::string WorkerPasses::check(const RedisReply& body, const std::string& worker, uint32_t& u, pt::FilmPass& pass) {
   const std::string *job = body.field("job"), *run = body.field("run"), *unit = body.field("unit"),
-                    *bytes = body.field("pass"), *error = body.field("error"), *sig = body.field("sig");
+                    *bytes = body.field("pass"), *error = body.field("error"), *sig = body.field("sig"),
+                    *name = body.field("worker");  // as signed; `worker` is its printable form
   if ((job && *job != m_job.id) || (run && *run != m_run))
     return "a result for another job or run (job '" + valid_utf8(job ? *job : m_job.id, 64) + "')";
   if (!unit || (!bytes && !error)) return "a malformed entry (no unit, or neither pass nor error)";
@@ -287,8 +289,9 @@ std::string WorkerPasses::check(const RedisReply& body, const std::string& worke
     if (!sig) return "unsigned";
     const std::string features = body.field("features") ? *body.field("features") : "";
     const std::string attempt = body.field("attempt") ? *body.field("attempt") : "";
-    const bool good = bytes ? m_key->verify(*sig, {"pt-result", m_job.id, m_run, *unit, worker, attempt, *bytes, features})
-                            : m_key->verify(*sig, {"pt-error", m_job.id, m_run, *unit, worker, *error});
+    const std::string signer = name ? *name : "";
+    const bool good = bytes ? m_key->verify(*sig, {"pt-result", m_job.id, m_run, *unit, signer, attempt, *bytes, features})
+                            : m_key->verify(*sig, {"pt-error", m_job.id, m_run, *unit, signer, *error});
     if (!good) return "bad signature (not made with the farm key, or made for another job, run, pass or worker)";
   }
   if (error) return "";  // signed (or an unsigned farm's): the job fails with its text

@@ -141,11 +141,16 @@ def test_requirepass_from_a_file_and_the_environment_and_wrong_passwords(tmp_pat
                                            "--farm-key-file", stack.key)
     assert rc == 1 and "WRONGPASS" in err and password not in err, err
 
-    # The password in the URL works too, with a warning that the process list shows it.
-    url_worker = stack.worker(f"redis://:{password}@127.0.0.1:{redis.port}", "w-url", "--farm-key-file", stack.key)
+    # The password in the URL works too, with a warning that the process list shows it. This worker's
+    # name is longer than the 64 bytes the server shows: its results are checked against the name it signed.
+    w.stop()
+    long_name = "w-url-" + "x" * 70
+    url_worker = stack.worker(f"redis://:{password}@127.0.0.1:{redis.port}", long_name, "--farm-key-file", stack.key)
     wait_for(lambda: "process list" in url_worker.text(), "the URL password warning")
     job2 = srv.api.submit(dict(SMALL, seed=9))["id"]
     assert srv.api.wait(job2, FINAL, timeout=180)["state"] == "done"
+    f = farm(srv.api)
+    assert f["rejected"] == 0 and any(x["name"] == long_name[:64] + "..." and x["passes"] > 0 for x in f["workers"]), f
 
 
 def acl_users(passwords):
