@@ -120,7 +120,7 @@ struct Denoiser::Api {
   }
 };
 
-// Devices by thread count, and the filters of the last size and quality each ran (a progressive
+// Devices by thread count, and for each quality the filters of the last size it ran (a progressive
 // preview denoises the same size at every pass; a filter's commit sets up its network).
 struct Denoiser::State {
   std::mutex mutex;
@@ -131,7 +131,7 @@ struct Denoiser::State {
   };
   struct DeviceFilters {
     Device device = nullptr;
-    Filters filters;
+    Filters filters[2];  // one set per quality: callers that alternate (--error-log) rebuild nothing
   };
   std::map<int, DeviceFilters> devices;
   std::vector<Vec3> albedo, normal;  // the cleaned features (final quality)
@@ -217,8 +217,8 @@ bool Denoiser::denoise(const ImageRGB& color, const ImageRGB& albedo, const Imag
     error = "denoiser: " + error;
     return false;
   }
-  State::Filters& f = df.filters;
   const bool clean = quality == DenoiseQuality::final;
+  State::Filters& f = df.filters[clean ? 1 : 0];
   if (!f.main || f.width != w || f.height != h || f.quality != quality) {
     for (Filter* x : {&f.main, &f.albedo, &f.normal})
       if (*x) api.oidnReleaseFilter(*x), *x = nullptr;

@@ -2,9 +2,11 @@
 // tests of what a broken or foreign library does: PT_OIDN_LIB points at it. Its "version" is
 // $FAKE_OIDN_VERSION (default 20501); with $FAKE_OIDN_FAIL set, executing a filter fails as out
 // of memory; otherwise a filter copies its colour to its output (a denoiser that does nothing),
-// with $FAKE_OIDN_NAN set putting NaNs in it.
+// with $FAKE_OIDN_NAN set putting NaNs in it. With $FAKE_OIDN_COUNT set it says at exit how many
+// filters were made (the renderer keeps its filters from call to call).
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -22,6 +24,15 @@ struct OIDNFilterImpl {
 using Device = OIDNDeviceImpl;
 using Filter = OIDNFilterImpl;
 
+namespace {
+int g_filters_made = 0;
+struct ReportAtExit {
+  ~ReportAtExit() {
+    if (std::getenv("FAKE_OIDN_COUNT")) std::fprintf(stderr, "fake-oidn: %d filters made\n", g_filters_made);
+  }
+} g_report;
+}  // namespace
+
 extern "C" {
 Device* oidnNewDevice(int) { return new Device; }
 void oidnCommitDevice(Device*) {}
@@ -38,7 +49,10 @@ int oidnGetDeviceError(Device* d, const char** message) {
   if (message) *message = e ? "fake: cannot allocate the filter's memory" : nullptr;
   return e;
 }
-Filter* oidnNewFilter(Device* d, const char*) { return new Filter{d}; }
+Filter* oidnNewFilter(Device* d, const char*) {
+  ++g_filters_made;
+  return new Filter{d};
+}
 void oidnSetSharedFilterImage(Filter* f, const char* name, void* ptr, int, size_t w, size_t h, size_t, size_t, size_t) {
   if (std::strcmp(name, "color") == 0) f->color = static_cast<float*>(ptr);
   if (std::strcmp(name, "output") == 0) f->output = static_cast<float*>(ptr);

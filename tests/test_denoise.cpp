@@ -252,6 +252,18 @@ TEST(DenoiseCli, AFailingDenoiserLeavesTheRawImageWithAWarning) {
   EXPECT_TRUE(test::file_exists(out));
 }
 
+// The error log denoises every pass at both qualities: each quality keeps its filters, so a whole
+// render makes one fast filter and the final quality's three (albedo, normal, colour), however many
+// passes it logs.
+TEST(DenoiseCli, EachQualityKeepsItsFiltersFromPassToPass) {
+  const std::string dir = test::temp_dir();
+  const test::RunResult r = test::run_command(std::string("FAKE_OIDN_COUNT=1 PT_OIDN_LIB=") + PT_FAKE_OIDN + " " +
+                                              PT_PATHTRACER + " -t 2 -s 16 -r 16 12 --quiet --no-adaptive --denoise --error-log " +
+                                              dir + "/filters.csv -f " + dir + "/filters.exr " + test::own_scene("cornell.dae"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("fake-oidn: 4 filters made"), std::string::npos) << r.output;
+}
+
 // Whatever the library writes, no NaN reaches the image: its pixel keeps the raw colour.
 TEST(DenoiseCli, ANonFiniteDenoiserOutputNeverReachesTheImage) {
   const std::string out = test::temp_dir() + "/nan.exr";
