@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -163,6 +164,11 @@ class TargetCheck {
   double m_worst = 0;
   std::string m_worst_label;
 };
+
+// Seconds since `t0` on the steady clock: what the benchmarks time.
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 inline double median(std::vector<double> v) {
   if (v.empty()) return 0;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "args.h"
+#include "bench_common.h"
 #include "farm_security.h"
 #include "redis_queue.h"
 #include "render_scene.h"
@@ -22,12 +23,8 @@ namespace {
 
 using clock_type = std::chrono::steady_clock;
 
-double since(clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); }
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using bench::median;
+double since(clock_type::time_point t0) { return bench::seconds_since(t0); }
 
 }  // namespace
 
@@ -37,6 +34,7 @@ int main(int argc, char** argv) {
   const int runs = args.integer("--runs", 9, 1, 1000);
   const int threads = args.integer("--threads", 2, 1, 1024);
   args.finish();
+  bench::print_host("bench_farm_sign");
   const pt::SceneBase base = pt::make_scene_base(pt::load_scene(PT_SOURCE_DIR "/scenes/cornell.dae"));
   const srv::FarmKey key("bench-farm-key-0123456789abcdef");
   struct Size { int w, h; };

@@ -13,18 +13,15 @@
 #include <vector>
 
 #include "args.h"
+#include "bench_common.h"
 #include "session.h"
 
 namespace {
 
 using clock_type = std::chrono::steady_clock;
 
-double since(clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); }
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using bench::median;
+double since(clock_type::time_point t0) { return bench::seconds_since(t0); }
 
 pt::FilmPass synthetic_pass(int w, int h, uint32_t first, uint32_t count, std::mt19937& rng) {
   std::uniform_real_distribution<float> u(0.f, 1.f);
@@ -52,6 +49,7 @@ int main(int argc, char** argv) {
   bench::Args args(argc, argv, "bench_film_merge [--passes N=9]");
   const int passes = args.integer("--passes", 9, 1, 1000);
   args.finish();
+  bench::print_host("bench_film_merge");
   struct Size { int w, h; };
   std::printf("frame        MB/pass  encode ms  decode ms  merge ms  tiles ms  server ms/pass (decode+merge+tiles)\n");
   for (Size s : {Size{240, 180}, Size{480, 360}, Size{800, 600}, Size{1920, 1080}}) {

@@ -25,7 +25,7 @@
 namespace {
 
 using clock_type = std::chrono::steady_clock;
-double since(clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); }
+double since(clock_type::time_point t0) { return bench::seconds_since(t0); }
 
 // Resident set now (Linux /proc/self/statm) and at its peak so far, in bytes.
 size_t resident_bytes() {

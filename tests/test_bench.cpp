@@ -218,6 +218,7 @@ TEST(BenchSmoke, NumbersAreCheckedAndNamed) {
        "bench_convergence: --ref-spp must be a whole number from 1 to 16777216, not '99999999999'"},
       {"bench_convergence --smoke --out", "bench_convergence: --out needs a value"},
       {"bench_film_merge --passes 0", "bench_film_merge: --passes must be a whole number from 1 to 1000, not '0'"},
+      {"bench_farm_sign --runs 0", "bench_farm_sign: --runs must be a whole number from 1 to 1000, not '0'"},
       {"bench_export_mitsuba --width 0 scene.dae out", "bench_export_mitsuba: --width must be a whole number from 1 to 16384"},
       {"bench_export_mitsuba scene.dae", "bench_export_mitsuba: needs a scene file and an output folder"},
   };
