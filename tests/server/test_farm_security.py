@@ -166,11 +166,13 @@ def acl_users(passwords):
 def test_acl_users_with_the_documented_rules(tmp_path, servers, stack):
     admin = "admin-" + os.urandom(8).hex()
     passwords = {"render-server": "srv-" + os.urandom(8).hex(), "render-worker": "wrk-" + os.urandom(8).hex()}
-    redis = stack.redis(args=["--requirepass", admin], password=admin)
     users = acl_users(passwords)
     assert {u[0] for u in users} == set(passwords), "scripts/redis-farm.acl names the two users"
-    for u in users:
-        assert redis.cli("ACL", "SETUSER", *u) == "OK", u
+    # The file as documented: loaded by redis-server --aclfile, with the passwords filled in.
+    acl = tmp_path / "farm.acl"
+    acl.write_text("".join(" ".join(["user", *u]) + "\n" for u in users) + f"user default on >{admin} ~* &* +@all\n")
+    redis = stack.redis(args=["--aclfile", str(acl)], password=admin)
+    assert sorted(redis.cli("ACL", "USERS").split()) == ["default", "render-server", "render-worker"]
     srv = servers("acl", threads=1, args=[
         "--queue", f"redis://render-server@127.0.0.1:{redis.port}", "--farm-key-file", stack.key,
         "--redis-password-file", write_secret(tmp_path / "server.pw", passwords["render-server"])])
