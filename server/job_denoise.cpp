@@ -13,9 +13,9 @@
 namespace srv {
 
 json denoise_json(const Job& j) {
-  if (j.spec.denoise == "off") return nullptr;
+  if (j.spec.denoise == DenoiseMode::off) return nullptr;
   const Job::Denoised& d = j.denoised;
-  json out{{"mode", j.spec.denoise},
+  json out{{"mode", denoise_mode_name(j.spec.denoise)},
            {"frames", d.frames},
            {"spp", d.frames ? json(d.spp) : json(nullptr)},
            {"seconds", d.frames ? json(d.seconds) : json(nullptr)},
@@ -31,9 +31,10 @@ json denoise_json(const Job& j) {
 }
 
 void require_denoiser(const JobSpec& spec) {
-  if (spec.denoise == "off" || pt::Denoiser::shared().available()) return;
-  throw JobError(JobErrorKind::unsupported, "'denoise' is \"" + spec.denoise + "\", but on this server " +
-                                                pt::Denoiser::shared().summary(),
+  if (spec.denoise == DenoiseMode::off || pt::Denoiser::shared().available()) return;
+  throw JobError(JobErrorKind::unsupported,
+                 std::string("'denoise' is \"") + denoise_mode_name(spec.denoise) + "\", but on this server " +
+                     pt::Denoiser::shared().summary(),
                  "denoise");
 }
 

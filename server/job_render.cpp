@@ -45,7 +45,7 @@ RenderResult render_job(pt::PassSource& source, const Job& job, JobSink& sink, c
   };
   // Denoised pictures at pass ends (fast quality), while they cost at most a tenth of the render
   // time so far; the first failure ends them (the job renders on, raw, saying why).
-  const bool denoising = job.spec.denoise != "off";
+  const bool denoising = job.spec.denoise != DenoiseMode::off;
   const int threads = std::max(1, job.spec.params.threads);
   double denoise_spent = 0;
   bool denoise_failed = false;
@@ -73,7 +73,7 @@ RenderResult render_job(pt::PassSource& source, const Job& job, JobSink& sink, c
   // The finished image (or what a user cancelled: it is stored too); not a pause or a shutdown.
   const bool kept = result.why != pt::StopReason::cancelled || job.cancel;
   if (denoising && kept && source.counts().samples > 0) {
-    const bool final = job.spec.denoise == "final";
+    const bool final = job.spec.denoise == DenoiseMode::final;
     result.denoised = pt::denoise_film(source.film(), final ? pt::DenoiseQuality::final : pt::DenoiseQuality::preview,
                                        threads, final);
     sink.denoised(result.denoised, spp_of(), true);

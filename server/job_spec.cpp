@@ -180,10 +180,9 @@ JobSpec parse_job_spec(const json& body, const SpecLimits& lim) {
   check([&] {
     const json* d = r.get("denoise");
     if (!d) return;
-    if (!d->is_string() || !valid_denoise_mode(d->get<std::string>()))
+    if (!d->is_string() || !parse_denoise_mode(d->get<std::string>(), s.denoise))
       throw JobError(JobErrorKind::invalid, "'denoise' must be \"off\", \"preview\" or \"final\"", "denoise");
-    s.denoise = d->get<std::string>();
-    p.features = s.denoise != "off";
+    p.features = s.denoise != DenoiseMode::off;
   });
   pt::RunLimits run;
   for (const pt::RenderOption& o : pt::render_options()) {  // every field from the one table
@@ -244,11 +243,26 @@ json job_spec_to_json(const JobSpec& s) {
     }
   }
   j["camera"] = camera_pose_json(s.params.camera);
-  j["denoise"] = s.denoise;
+  j["denoise"] = denoise_mode_name(s.denoise);
   return j;
 }
 
-bool valid_denoise_mode(const std::string& mode) { return mode == "off" || mode == "preview" || mode == "final"; }
+const char* denoise_mode_name(DenoiseMode mode) {
+  switch (mode) {
+    case DenoiseMode::preview: return "preview";
+    case DenoiseMode::final: return "final";
+    default: return "off";
+  }
+}
+
+bool parse_denoise_mode(const std::string& name, DenoiseMode& mode) {
+  for (DenoiseMode m : {DenoiseMode::off, DenoiseMode::preview, DenoiseMode::final})
+    if (name == denoise_mode_name(m)) {
+      mode = m;
+      return true;
+    }
+  return false;
+}
 
 json job_spec_defaults() {
   json j = job_spec_to_json(parse_job_spec(json{{"scene", "default"}}));

@@ -52,17 +52,20 @@ class JobError : public std::runtime_error {
   FieldErrors m_errors;
 };
 
+enum class DenoiseMode { off, preview, final };
+
 struct JobSpec {
   std::string scene;          // a scene file's name without ".dae"
   pt::RenderParams params;    // threads is the server's, not the client's
   double time_limit = 0;      // seconds; 0 = none
   double target_error = 0;    // stop when the error estimate reaches this; 0 = none
-  // "off", "preview" (denoised frames at pass ends and a denoised image, fast quality) or "final"
-  // (the same, the finished image at high quality with its noise estimate). Not off: params.features.
-  std::string denoise = "off";
+  // off, preview (denoised frames at pass ends and a denoised image, fast quality) or final (the
+  // same, the finished image at high quality with its noise estimate). Not off: params.features.
+  DenoiseMode denoise = DenoiseMode::off;
 };
-// The denoise field's values.
-bool valid_denoise_mode(const std::string& mode);
+// The denoise field's names: "off", "preview", "final"; parse_denoise_mode is false for any other.
+const char* denoise_mode_name(DenoiseMode mode);
+bool parse_denoise_mode(const std::string& name, DenoiseMode& mode);
 
 // The job service's policy: narrower ranges than the render options' own (renderer/options.h) where a
 // job would cost the shared server too much, or its watchers too many tiles.
